@@ -1,0 +1,1 @@
+"""Assembler, disassembler and memory-image formats for REND3R programs."""

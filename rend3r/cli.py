@@ -1,0 +1,50 @@
+"""The ``rend3r`` command line: a thin click group whose commands load on demand.
+
+Each command lives in its concern's sub-package; this module imports it only when that
+command runs, so ``rend3r --help`` and ``rend3r asm`` never pay for numpy-heavy or
+scapy-heavy modules they do not use.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+import click
+
+from . import __version__
+
+#: command name -> ("module:attribute", one-line help shown by ``rend3r --help``)
+COMMANDS: dict[str, tuple[str, str]] = {
+}
+
+
+class LazyGroup(click.Group):
+    """A click group that imports a command's module only when the command is used."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted(COMMANDS)
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        if name not in COMMANDS:
+            return None
+        target, _ = COMMANDS[name]
+        module_name, attr = target.split(":")
+        return getattr(importlib.import_module(module_name), attr)
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        rows = [(name, COMMANDS[name][1]) for name in self.list_commands(ctx)]
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="rend3r")
+def main() -> None:
+    """Toolchain for the REND3R graphics ISA and rendering device.
+
+    \b
+    Example:
+      rend3r asm programs/sphere.r3 -o sphere.mem
+      rend3r emulate programs/sphere.r3 -o sphere.png
+    """

@@ -1,0 +1,128 @@
+"""IEEE 754 binary16 conversions used by the encoder, assembler and disassembler.
+
+Decimal literals are rounded to float16 *exactly* (round to nearest, ties to even) from
+their decimal value, not through a float64 first, so no double rounding can occur.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+MAX_FINITE = 65504.0
+MIN_NORMAL = 2.0**-14
+MIN_SUBNORMAL = 2.0**-24
+#: Values at or above this magnitude round to infinity (halfway between 65504 and 65536).
+OVERFLOW_THRESHOLD = 65520.0
+
+_HALF_ULP_CACHE: dict[int, float] = {}
+
+
+@dataclass(frozen=True)
+class Rounded:
+    """The float16 nearest to a literal, and what the rounding did to it."""
+
+    bits: int
+    value: float  # the float16's value (inf when it overflowed)
+    overflow: bool  # |value| >= 65520: rounds to infinity
+    underflow: bool  # nonzero literal rounded to (signed) zero
+    relative_error: float  # |rounded - exact| / |exact|; 0 for an exact zero
+
+
+def bits_to_float(bits: int) -> float:
+    """The value of a float16 bit pattern (NaN and infinities included)."""
+    return float(np.array(bits & 0xFFFF, dtype=np.uint16).view(np.float16))
+
+
+def float_to_bits(value: float) -> int:
+    """Round a Python float to float16 (nearest even) and return the bit pattern.
+
+    Rounding a float64 is exact except when the float64 itself came from rounding a
+    decimal; use :func:`round_literal` for source literals.
+    """
+    return int(np.array(value, dtype=np.float16).view(np.uint16))
+
+
+def round_literal(text: str | Fraction | int | float, negative: bool = False) -> Rounded:
+    """Round a numeric literal to float16, correctly, ties to even.
+
+    ``text`` is a decimal or exponent literal (``"1.5e-3"``, ``"1_000.25"``), an exact
+    Fraction or an int; ``negative`` negates it (so ``-0`` gives 0x8000).
+    """
+    exact = Fraction(text.replace("_", "")) if isinstance(text, str) else Fraction(text)
+    if negative:
+        exact = -exact
+    neg = exact < 0 or (exact == 0 and negative)
+    mag = abs(exact)
+    if mag == 0:
+        bits = 0x8000 if neg else 0
+        return Rounded(bits, bits_to_float(bits), False, False, 0.0)
+    approx = float(mag) if mag < 1e300 else math.inf
+    if approx != math.inf and not _may_be_tie(approx):
+        # float(mag) is correctly rounded to float64; since float16 ties are float64
+        # values, the exact value and its float64 lie on the same side of every tie.
+        bits = float_to_bits(approx)
+    else:
+        bits = _round_fraction(mag)
+    if neg:
+        bits |= 0x8000
+    value = bits_to_float(bits)
+    overflow = math.isinf(value)
+    underflow = value == 0.0
+    rel = 1.0 if (overflow or underflow) else float(abs(Fraction(abs(value)) - mag) / mag)
+    return Rounded(bits, value, overflow, underflow, rel)
+
+
+def _may_be_tie(x: float) -> bool:
+    """True when x is exactly halfway between two float16 values (or at the overflow tie)."""
+    m, e = math.frexp(x)  # x = m * 2**e, 0.5 <= m < 1
+    # float16 spacing at x: 2**(e-11) for normals, 2**-24 in the subnormal range.
+    ulp_exp = max(e - 11, -24)
+    scaled = x / 2.0 ** (ulp_exp - 1)  # exact: power-of-two scaling
+    return scaled == int(scaled) and int(scaled) % 2 == 1
+
+
+def _round_fraction(mag: Fraction) -> int:
+    """Round a positive Fraction to float16 bits, ties to even, with overflow to inf."""
+    if mag >= Fraction(int(OVERFLOW_THRESHOLD)):
+        return 0x7C00
+    e = mag.numerator.bit_length() - mag.denominator.bit_length()
+    if Fraction(2) ** e > mag:
+        e -= 1
+    ulp_exp = max(e - 10, -24)
+    q = mag / Fraction(2) ** ulp_exp
+    n = q.numerator // q.denominator
+    rem = q - n
+    if rem > Fraction(1, 2) or (rem == Fraction(1, 2) and n % 2 == 1):
+        n += 1
+    value = Fraction(n) * Fraction(2) ** ulp_exp
+    if value >= 65536:
+        return 0x7C00
+    return float_to_bits(float(value))
+
+
+def is_nan(bits: int) -> bool:
+    return (bits & 0x7C00) == 0x7C00 and (bits & 0x03FF) != 0
+
+
+def is_inf(bits: int) -> bool:
+    return (bits & 0x7FFF) == 0x7C00
+
+
+def is_subnormal(bits: int) -> bool:
+    return (bits & 0x7C00) == 0 and (bits & 0x03FF) != 0
+
+
+def shortest_repr(bits: int) -> str | None:
+    """Shortest decimal that rounds back to ``bits``; None for NaN and infinities."""
+    if is_nan(bits) or is_inf(bits):
+        return None
+    h = np.array(bits & 0xFFFF, dtype=np.uint16).view(np.float16)[()]
+    text = np.format_float_positional(h, unique=True, trim="0")
+    sci = np.format_float_scientific(h, unique=True, trim="0")
+    if len(sci) < len(text):
+        text = sci.replace("e+", "e")
+    return text

@@ -12,6 +12,7 @@ import importlib
 import click
 
 from . import __version__
+from .errors import Rend3rError
 
 #: command name -> ("module:attribute", one-line help shown by ``rend3r --help``)
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -30,6 +31,13 @@ class LazyGroup(click.Group):
         target, _ = COMMANDS[name]
         module_name, attr = target.split(":")
         return getattr(importlib.import_module(module_name), attr)
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except Rend3rError as exc:
+            click.echo(f"rend3r: error: {exc}", err=True)
+            ctx.exit(exc.exit_code)
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         rows = [(name, COMMANDS[name][1]) for name in self.list_commands(ctx)]

@@ -1,0 +1,18 @@
+"""User-facing errors: reported by the CLI as one clear message and exit status 1."""
+
+from __future__ import annotations
+
+
+class Rend3rError(Exception):
+    """An error caused by the user's input or environment, never a bug.
+
+    The CLI prints ``rend3r: error: <message>`` (the message may already carry a
+    ``file:line:col:`` prefix) and exits with ``exit_code``; no traceback is shown.
+    """
+
+    exit_code = 1
+
+    def __init__(self, message: str, exit_code: int | None = None) -> None:
+        super().__init__(message)
+        if exit_code is not None:
+            self.exit_code = exit_code

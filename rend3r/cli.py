@@ -53,6 +53,6 @@ def main() -> None:
 
     \b
     Example:
-      rend3r asm programs/sphere.r3 -o sphere.mem
-      rend3r emulate programs/sphere.r3 -o sphere.png
+      rend3r asm programs/sphere.asm -o sphere.mem
+      rend3r emulate programs/sphere.asm -o sphere.png
     """

@@ -43,7 +43,8 @@ def float_to_bits(value: float) -> int:
     Rounding a float64 is exact except when the float64 itself came from rounding a
     decimal; use :func:`round_literal` for source literals.
     """
-    return int(np.array(value, dtype=np.float16).view(np.uint16))
+    with np.errstate(over="ignore"):
+        return int(np.array(value, dtype=np.float16).view(np.uint16))
 
 
 def round_literal(text: str | Fraction | int | float, negative: bool = False) -> Rounded:

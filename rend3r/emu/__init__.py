@@ -1,0 +1,1 @@
+"""The REND3R emulator: instruction processor, float16 raytracer and rasterizer."""

@@ -1,0 +1,96 @@
+"""Working-precision arithmetic for the emulator's datapaths.
+
+One :class:`Arith` per precision; the raytracer and rasterizer are written once against it.
+Every operation rounds its result to the working format, as one hardware unit would:
+
+- ``fp16``: each result is computed in float32 and rounded to float16 (nearest even).
+  float32 carries 24 >= 2*11 + 2 significand bits, so for + - * / and sqrt this double
+  rounding is innocuous (Figueroa 1995): the result equals a correctly rounded float16
+  operation. With ``ftz`` (the vendor IP's treatment) subnormal results and loaded
+  subnormal values become signed zero, so no operation ever sees a subnormal input.
+- ``fp32`` / ``fp64``: native numpy arithmetic in that format (``ftz`` does not apply).
+
+Arrays are held as float32 for fp16 and fp32 (fp16 values are exact in float32), float64
+for fp64. Overflow gives infinities and invalid operations NaN, silently here: callers
+decide what a non-finite value means (the raytracer counts such rays as misses).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+Precision = Literal["fp16", "fp32", "fp64"]
+PRECISIONS: tuple[Precision, ...] = ("fp16", "fp32", "fp64")
+_FP16_MIN_NORMAL = np.float32(2.0**-14)
+
+
+@dataclass(frozen=True)
+class Arith:
+    """Rounded arithmetic in one working precision."""
+
+    precision: Precision = "fp16"
+    ftz: bool = True
+
+    @property
+    def dtype(self) -> type[np.floating]:
+        return np.float64 if self.precision == "fp64" else np.float32
+
+    @property
+    def label(self) -> str:
+        if self.precision == "fp16":
+            return f"fp16-{'ftz' if self.ftz else 'ieee'}"
+        return self.precision
+
+    def round(self, x: np.ndarray | float) -> np.ndarray:
+        """Round values (already in or above working precision) to the working format."""
+        a = np.asarray(x, dtype=self.dtype)
+        if self.precision != "fp16":
+            return a
+        with np.errstate(over="ignore", invalid="ignore"):
+            r = a.astype(np.float16).astype(np.float32)
+        if self.ftz:
+            r = np.where(np.abs(r) < _FP16_MIN_NORMAL, np.copysign(np.float32(0), r), r)
+        return r
+
+    def const(self, value: float) -> np.ndarray:
+        """A scalar constant in working precision (0-d array)."""
+        return self.round(np.float64(value))
+
+    def add(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        with np.errstate(all="ignore"):
+            return self.round(np.add(a, b, dtype=self.dtype))
+
+    def sub(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        with np.errstate(all="ignore"):
+            return self.round(np.subtract(a, b, dtype=self.dtype))
+
+    def mul(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        with np.errstate(all="ignore"):
+            return self.round(np.multiply(a, b, dtype=self.dtype))
+
+    def div(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        with np.errstate(all="ignore"):
+            return self.round(np.divide(a, b, dtype=self.dtype))
+
+    def sqrt(self, a: np.ndarray) -> np.ndarray:
+        with np.errstate(all="ignore"):
+            return self.round(np.sqrt(np.asarray(a, dtype=self.dtype)))
+
+    def neg(self, a: np.ndarray) -> np.ndarray:
+        """Negation flips the sign bit: exact in every format."""
+        return np.negative(np.asarray(a, dtype=self.dtype))
+
+    def from_bits(self, bits: np.ndarray | int) -> np.ndarray:
+        """float16 bit patterns (as stored by the ISA) to working-precision values."""
+        h = np.asarray(bits, dtype=np.uint16).view(np.float16)
+        return self.round(h.astype(self.dtype))
+
+
+def make_arith(precision: Precision = "fp16", subnormals: Literal["ftz", "ieee"] = "ftz") -> Arith:
+    """The arithmetic for a ``--precision`` / ``--subnormals`` pair."""
+    if precision not in PRECISIONS:
+        raise ValueError(f"unknown precision {precision!r}; expected one of {', '.join(PRECISIONS)}")
+    return Arith(precision, subnormals == "ftz")

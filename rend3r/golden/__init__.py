@@ -1,0 +1,1 @@
+"""Golden images: image metrics, ``rend3r compare`` and ``rend3r render-all``."""

@@ -1,0 +1,80 @@
+"""``rend3r compare`` on real files, through the CLI group."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from click.testing import CliRunner
+from PIL import Image
+
+from rend3r.cli import main
+
+
+def _png(path: Path, rgb: np.ndarray) -> Path:
+    Image.fromarray(rgb, mode="RGB").save(path)
+    return path
+
+
+def _raw(path: Path, fb: np.ndarray) -> Path:
+    path.write_bytes(fb.astype("<u2").tobytes())
+    return path
+
+
+def test_identical_pngs_exit_0(tmp_path: Path) -> None:
+    rgb = np.random.default_rng(1).integers(0, 256, (6, 8, 3), dtype=np.uint8)
+    a, b = _png(tmp_path / "a.png", rgb), _png(tmp_path / "b.png", rgb)
+    r = CliRunner().invoke(main, ["compare", str(a), str(b)])
+    assert r.exit_code == 0, r.output
+    assert "PSNR inf dB" in r.output and "within tolerance" in r.output
+
+
+def test_difference_beyond_tolerance_exit_1_and_diff(tmp_path: Path) -> None:
+    rgb = np.zeros((4, 4, 3), dtype=np.uint8)
+    other = rgb.copy()
+    other[2, 3] = (0, 40, 0)
+    a, b = _png(tmp_path / "a.png", rgb), _png(tmp_path / "b.png", other)
+    diff = tmp_path / "sub" / "d.png"
+    r = CliRunner().invoke(main, ["compare", str(a), str(b), "--diff", str(diff)])
+    assert r.exit_code == 1, r.output
+    assert "max channel difference 40" in r.output and "NOT within tolerance" in r.output
+    d = np.asarray(Image.open(diff))
+    assert d.shape == (4, 4, 3) and d[2, 3, 0] > 0 and d[2, 3, 1] == 0 and d[0, 0].tolist() == [0, 0, 0]
+    r = CliRunner().invoke(main, ["compare", str(a), str(b), "--max-channel", "40", "--max-share", "0.0625"])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(main, ["compare", str(a), str(b), "--max-channel", "40", "--min-psnr", "40"])
+    assert r.exit_code == 1, r.output
+
+
+def test_raw_framebuffer_against_png(tmp_path: Path) -> None:
+    fb = np.array([[0xF800, 0x07E0, 0x001F], [0xFFFF, 0, 0x8410]], dtype=np.uint16)
+    raw = _raw(tmp_path / "fb.bin", fb)
+    from rend3r.golden.metrics import rgb565_to_rgb888
+
+    png = _png(tmp_path / "fb.png", rgb565_to_rgb888(fb))
+    r = CliRunner().invoke(main, ["compare", str(raw), str(png), "--size", "3x2"])
+    assert r.exit_code == 0, r.output
+
+
+def test_raw_device_size_needs_no_size(tmp_path: Path) -> None:
+    fb = np.zeros((384, 512), dtype=np.uint16)
+    a = _raw(tmp_path / "a.bin", fb)
+    fb[0, 0] = 1
+    b = _raw(tmp_path / "b.bin", fb)
+    r = CliRunner().invoke(main, ["compare", str(a), str(b)])
+    assert r.exit_code == 1 and "differing pixels 1/196608" in r.output
+
+
+def test_errors_are_clean(tmp_path: Path) -> None:
+    odd = tmp_path / "odd.bin"
+    odd.write_bytes(b"\x00" * 10)
+    r = CliRunner().invoke(main, ["compare", str(odd), str(odd)])
+    assert r.exit_code == 1 and "rend3r: error:" in r.output and "--size" in r.output
+    r = CliRunner().invoke(main, ["compare", str(tmp_path / "missing.png"), str(odd)])
+    assert r.exit_code == 1 and "cannot read" in r.output
+    a = _png(tmp_path / "a.png", np.zeros((2, 2, 3), np.uint8))
+    b = _png(tmp_path / "b.png", np.zeros((2, 3, 3), np.uint8))
+    r = CliRunner().invoke(main, ["compare", str(a), str(b)])
+    assert r.exit_code == 1 and "sizes differ" in r.output
+    r = CliRunner().invoke(main, ["compare", str(a), str(b), "--size", "3by2"])
+    assert r.exit_code == 1 and "bad size" in r.output

@@ -16,6 +16,7 @@ from .errors import Rend3rError
 
 #: command name -> ("module:attribute", one-line help shown by ``rend3r --help``)
 COMMANDS: dict[str, tuple[str, str]] = {
+    "disasm": ("rend3r.asm.cli_disasm:disasm_command", "Disassemble a memory image (mem, bin, coe, ihex, lst) to source."),
 }
 
 

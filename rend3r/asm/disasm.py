@@ -1,0 +1,159 @@
+"""Disassembler: 32-bit words to canonical rend3r assembly (see ``docs/isa.md``).
+
+Every word stream disassembles to source that assembles back to the same words: words
+that decode to nothing become ``.word`` directives with a comment giving the reason.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..isa.encoding import is_canonical
+from ..isa.float16 import shortest_repr
+from ..isa.tables import (
+    DATA,
+    F_MNEMONICS,
+    FUNC,
+    LIGHT_INDEX,
+    OPCODE,
+    PROP,
+    SD_DATA,
+    SD_DATA2,
+    SE_INDEX_HI,
+    SE_INDEX_LO,
+    SE_PROP2,
+    Func,
+    Opcode,
+    Property,
+    Table,
+    ValueType,
+    by_index,
+)
+from .formats.common import address_width
+from .program import Emitted, Program
+
+#: mode -> (shape mnemonic, the table its property operands name)
+MODES: dict[str, tuple[str, Table]] = {"raytrace": ("sp", Table.SHAPE), "raster": ("tr", Table.TRIANGLE)}
+
+_F_NAMES = {func: name for name, func in F_MNEMONICS.items()}
+_COMMENT_COLUMN = 40
+
+
+@dataclass(frozen=True)
+class Line:
+    """One line of disassembly: the word(s) it stands for and its source text."""
+
+    address: int
+    words: tuple[int, ...]
+    text: str
+    note: str = ""  # why a .word line is not an instruction
+
+
+def format_value(prop: Property, bits: int) -> str:
+    """A 16-bit field as the canonical operand for ``prop``."""
+    if prop.vtype is ValueType.ZERO:
+        return "0" if bits == 0 else f"0h{bits:04x}"
+    if prop.vtype is ValueType.FLOAT16:
+        text = shortest_repr(bits)
+        return text if text is not None else f"0h{bits:04x}"
+    if bits >> prop.bits:
+        return f"0h{bits:04x}"
+    if prop.name == "col":
+        return f"0b{bits >> 11:05b}_{(bits >> 5) & 0x3F:06b}_{bits & 0x1F:05b}"
+    return str(bits)
+
+
+def _word(address: int, word: int, note: str) -> Line:
+    return Line(address, (word,), f".word 0x{word:08x}", note)
+
+
+def _single(address: int, word: int) -> Line:
+    """A one-word instruction (F, C or L), or a .word saying why it is none."""
+    op = OPCODE.get(word)
+    if op == Opcode.F:
+        if not is_canonical(word):
+            return _word(address, word, "F-type with nonzero reserved bits")
+        return Line(address, (word,), _F_NAMES[Func(FUNC.get(word))])
+    if op == Opcode.C:
+        if not is_canonical(word):
+            return _word(address, word, "C-type with nonzero reserved bits 10:3")
+        prop = by_index(Table.CAMERA).get(PROP.get(word))
+        if prop is None:
+            return _word(address, word, f"camera property {PROP.get(word)} does not exist")
+        return Line(address, (word,), f"cam {prop.name}, {format_value(prop, DATA.get(word))}")
+    if op == Opcode.L:
+        if not is_canonical(word):
+            return _word(address, word, "L-type with nonzero reserved bits 10:9")
+        prop = by_index(Table.LIGHT).get(PROP.get(word))
+        if prop is None:
+            return _word(address, word, f"light property {PROP.get(word)} does not exist")
+        value = format_value(prop, DATA.get(word))
+        return Line(address, (word,), f"lt {LIGHT_INDEX.get(word)}, {prop.name}, {value}")
+    if op == 0b100:
+        return _word(address, word, "reserved opcode 100 (shape init, never defined)")
+    return _word(address, word, f"unused opcode {op:03b}")
+
+
+def _pair(address: int, se: int, sd: int, mode: str) -> list[Line]:
+    """An SE/SD pair as one sp/tr line, or as two .word lines when a property is missing."""
+    mnemonic, table = MODES[mode]
+    props = by_index(table)
+    prop, prop2 = props.get(PROP.get(se)), props.get(SE_PROP2.get(se))
+    if prop is None or prop2 is None:
+        missing = PROP.get(se) if prop is None else SE_PROP2.get(se)
+        return [
+            _word(address, se, f"SE names {table.value} property {missing}, which does not exist"),
+            _word(address + 1, sd, "SD of the SE above"),
+        ]
+    index = (SE_INDEX_HI.get(se) << 3) | SE_INDEX_LO.get(se)
+    v1, v2 = format_value(prop, SD_DATA.get(sd)), format_value(prop2, SD_DATA2.get(sd))
+    return [Line(address, (se, sd), f"{mnemonic} {index}, {prop.name}, {prop2.name}, {v1}, {v2}")]
+
+
+def disassemble_lines(words: list[int], mode: str = "raytrace") -> list[Line]:
+    """Decode ``words`` as the device does (an SE always takes the next word as its SD)."""
+    if mode not in MODES:
+        raise ValueError(f"unknown mode {mode!r}; expected one of {', '.join(MODES)}")
+    lines: list[Line] = []
+    address = 0
+    while address < len(words):
+        word = words[address]
+        if not 0 <= word < 1 << 32:
+            raise ValueError(f"word {word} at address {address} is not a 32-bit value")
+        if OPCODE.get(word) == Opcode.SE:
+            if address + 1 == len(words):
+                lines.append(_word(address, word, "SE with no SD at the end"))
+                break
+            lines.extend(_pair(address, word, words[address + 1], mode))
+            address += 2
+        else:
+            lines.append(_single(address, word))
+            address += 1
+    return lines
+
+
+def disassemble_program(words: list[int], mode: str = "raytrace") -> Program:
+    """The disassembly as a Program (no source positions), e.g. for a listing."""
+    return Program([Emitted(line.address, line.words, None, _with_note(line.text, line.note)) for line in disassemble_lines(words, mode)])
+
+
+def disassemble(words: list[int], mode: str = "raytrace", addresses: bool = False) -> str:
+    """Canonical source for ``words``: a header comment, then one statement per line.
+
+    ``addresses`` adds each statement's word address (hex) as a trailing comment.
+    """
+    lines = disassemble_lines(words, mode)
+    width = address_width(len(words))
+    mnemonic, table = MODES[mode]
+    out = [f"; rend3r disassembly: {len(words)} words, {mode} mode ({mnemonic} names {table.value} properties)"]
+    for line in lines:
+        if addresses:
+            comment = f"@{line.address:0{width}x} {line.note}".rstrip()
+            out.append(f"{line.text:<{_COMMENT_COLUMN - 1}} ; {comment}")
+        else:
+            out.append(_with_note(line.text, line.note))
+    return "\n".join(out) + "\n"
+
+
+def _with_note(text: str, note: str) -> str:
+    return f"{text}  ; {note}" if note else text

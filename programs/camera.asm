@@ -1,0 +1,44 @@
+; camera.asm: camera moved, rotated, field of view and clip planes changed.
+;
+; Shows:  every camera property. A row of five spheres runs along -z from z = -4 to
+;         z = -20 at x = 0. The camera stands at (3, 1.5, 0), turned 12 degrees to the
+;         left (about +y) and tilted 5 degrees down (about x), with the field of view
+;         narrowed to 0.6 of the default in both axes; the near clip is 1 and the far clip
+;         13, so only the spheres nearer than 13 units are drawn.
+; Run:    rend3r emulate programs/camera.asm -o camera.png
+; Look:   three orange-to-yellow spheres shrinking into the distance from the lower left
+;         towards the centre; the two farther spheres are cut away by the far clip plane.
+; frames: 1
+
+nr
+cam zero, 0
+cam xloc, 3
+cam yloc, 1.5
+cam zloc, 0
+cam rrot, 0.99357                ; q = rot(y, 12 deg) * rot(x, -5 deg)
+cam irot, -0.04338
+cam jrot, 0.10443
+cam krot, 0.00456
+cam nclip, 1
+cam fclip, 13
+cam hfov, 0.6
+cam vfov, 0.6
+
+lt 0, src, 1
+lt 0, xfor, -0.5
+lt 0, yfor, -1
+lt 0, zfor, -0.5
+lt 0, col, 0xFFFF
+lt 0, int, 1
+
+.rept 5, i
+sp i, type, col, 1, 0b11111_101000_00100 + i * 0b00000_000100_00110
+sp i, xloc, yloc, 0, 0
+sp i, zloc, rrot, -4 - 4 * i, 1
+sp i, xscl, yscl, 1, 1
+sp i, zscl, mat, 1, 0
+.endr
+
+nf
+er
+er

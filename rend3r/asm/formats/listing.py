@@ -40,7 +40,7 @@ def render_lst(program: Program) -> bytes:
         chunks = [entry.words[i : i + WORDS_PER_ROW] for i in range(0, len(entry.words), WORDS_PER_ROW)] or [()]
         for k, chunk in enumerate(chunks):
             cells = " ".join(f"{w:08x}" for w in chunk)
-            source = entry.text.rstrip() if k == 0 else ""
+            source = entry.text.strip() if k == 0 else ""
             row = f"{label if k == 0 else '':>{line_w}} | {address:0{addr_w}x} | {cells:<{_WORDS_WIDTH}} | {source}"
             rows.append(row.rstrip())
             address += len(chunk)

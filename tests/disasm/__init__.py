@@ -1,0 +1,1 @@
+"""Tests of the memory-image formats, the disassembler and the round trips."""

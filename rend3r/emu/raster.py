@@ -1,0 +1,309 @@
+"""The triangle rasterizer (``--mode raster``), vectorised over triangles and pixels.
+
+Pipeline, per frame (see ``docs/raster.md``):
+
+1. World -> camera space in the working precision, in the raytracer's order: translate by
+   the negated camera location, rotate by the inverse camera quaternion.
+2. Clip against the near plane and a guard band (:mod:`.raster_clip`).
+3. Project each vertex in the device's float16 order: ``s = near*coord/(-z)``,
+   ``ndc = s/canvas + 0.5``, ``px = ndc_x*W``, ``py = (1 - ndc_y)*H``; snap to a
+   fixed-point grid (the device's ``round``; the spec keeps 8 sub-pixel bits).
+4. Exact coverage with the top-left fill rule (:mod:`.raster_cover`).
+5. Depth = distance from the eye along the pixel's ray to the triangle's plane, stored in
+   the working format; z-buffer (nearest wins, ties to the earlier triangle) or painter
+   (centroid distance descending, the paper's order; later draws win).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .arith import Arith
+from .raster_clip import ClipPlanes, clip_triangles
+from .raster_cover import fragments, spans
+from .vec import Quat, rotate_inverse
+
+DEPTH_MODES = ("zbuffer", "painter")
+#: Projected coordinates stay within this many screen sizes of the screen centre.
+_GUARD_SCREENS = 8.0
+#: Fragments handled per batch: bounds memory on scenes with many large triangles.
+_BATCH_FRAGMENTS = 1 << 22
+
+
+@dataclass(frozen=True)
+class RasterView:
+    """The camera as the rasterizer sees it, all values already in working precision.
+
+    ``canvas`` is the viewport size (width, height) in world units at distance ``near``
+    in front of the eye; ``far`` bounds the camera-space depth ``-z`` (inf: no bound), as
+    the raytracer's ``tmax = far/near`` does.
+    """
+
+    location: np.ndarray  # (3,)
+    rotation: Quat | None  # unit quaternion r, i, j, k; None: no rotation
+    near: float
+    far: float
+    canvas: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class RasterRules:
+    """How coverage and placement work: the spec's rules or the original device's."""
+
+    subpixel_bits: int = 8
+    centre_samples: bool = True
+    fill_rule: str = "top-left"
+    column_offset: int = 0  # device defect: pixels land this many columns to the right
+
+
+SPEC_RULES = RasterRules()
+
+
+@dataclass
+class RasterStats:
+    """What one rasterized frame did."""
+
+    triangles: int = 0
+    clipped: int = 0
+    rejected: int = 0
+    nonfinite: int = 0  # (sub)triangles dropped because a projected vertex was not finite
+    fragments: int = 0
+
+
+@dataclass
+class RasterResult:
+    """A rasterized frame: RGB565, distance along each pixel's ray, triangle index."""
+
+    rgb565: np.ndarray
+    depth: np.ndarray
+    provenance: np.ndarray
+    stats: RasterStats = field(default_factory=RasterStats)
+
+
+def to_camera(ar: Arith, p: np.ndarray, view: RasterView) -> np.ndarray:
+    """World points (..., 3) -> camera space: ``conj(q) * (0, p - loc) * q``, as the shapes do."""
+    rel = tuple(ar.sub(p[..., c], view.location[c]) for c in range(3))
+    cam = rel if view.rotation is None else rotate_inverse(ar, view.rotation, rel)
+    return np.stack(cam, axis=-1)
+
+
+def project(ar: Arith, v: np.ndarray, view: RasterView, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """Camera-space vertices (..., 3) -> screen coordinates (px, py), device order."""
+    near = ar.const(view.near)
+    w = ar.neg(v[..., 2])
+    sx = ar.div(ar.mul(near, v[..., 0]), w)
+    sy = ar.div(ar.mul(near, v[..., 1]), w)
+    half, one = ar.const(0.5), ar.const(1.0)
+    ndc_x = ar.add(ar.div(sx, ar.const(view.canvas[0])), half)
+    ndc_y = ar.add(ar.div(sy, ar.const(view.canvas[1])), half)
+    return ar.mul(ndc_x, ar.const(width)), ar.mul(ar.sub(one, ndc_y), ar.const(height))
+
+
+@dataclass(frozen=True)
+class ScreenTriangles:
+    """Clipped triangles: camera-space vertices, fixed-point screen vertices, source index."""
+
+    camera: np.ndarray  # (M, 3, 3) working precision
+    x: np.ndarray  # (M, 3) int64, 1/2**subpixel_bits pixel units
+    y: np.ndarray
+    parent: np.ndarray  # (M,) index of the source triangle
+    clipped: int
+    rejected: int
+    nonfinite: int
+
+
+def screen_triangles(
+    ar: Arith, cam: np.ndarray, view: RasterView, size: tuple[int, int], rules: RasterRules = SPEC_RULES
+) -> ScreenTriangles:
+    """Clip camera-space triangles (N, 3, 3), project them and snap to the sub-pixel grid."""
+    width, height = size
+    clipped = clip_triangles(ar, cam, _clip_planes(ar, view, width, height))
+    px, py = project(ar, clipped.vertices, view, width, height)
+    one = float(1 << rules.subpixel_bits)
+    with np.errstate(invalid="ignore", over="ignore"):
+        fx, fy = px.astype(np.float64) * one, py.astype(np.float64) * one
+    finite = np.isfinite(fx).all(axis=1) & np.isfinite(fy).all(axis=1)
+    return ScreenTriangles(
+        camera=clipped.vertices[finite],
+        x=np.rint(fx[finite]).astype(np.int64),
+        y=np.rint(fy[finite]).astype(np.int64),
+        parent=clipped.parent[finite],
+        clipped=clipped.clipped,
+        rejected=clipped.rejected,
+        nonfinite=int((~finite).sum()),
+    )
+
+
+def centroid_sq_distance(ar: Arith, cam_tris: np.ndarray) -> np.ndarray:
+    """Squared eye distance of each camera-space triangle's centroid (painter's key)."""
+    c = ar.div(ar.add(ar.add(cam_tris[:, 0], cam_tris[:, 1]), cam_tris[:, 2]), ar.const(3.0))
+    sq = ar.mul(c, c)
+    return ar.add(ar.add(sq[:, 0], sq[:, 1]), sq[:, 2])
+
+
+def rasterize(
+    tris: np.ndarray,
+    colours: np.ndarray,
+    view: RasterView,
+    ar: Arith,
+    size: tuple[int, int],
+    depth_mode: str = "zbuffer",
+    background: int = 0,
+    rules: RasterRules = SPEC_RULES,
+) -> RasterResult:
+    """Rasterize world-space triangles ``tris`` (N, 3, 3) with flat RGB565 ``colours`` (N,).
+
+    ``size`` is (width, height). Provenance holds the index into ``tris`` (-1: none).
+    """
+    if depth_mode not in DEPTH_MODES:
+        raise ValueError(f"unknown depth mode {depth_mode!r}; expected zbuffer or painter")
+    width, height = size
+    stats = RasterStats(triangles=int(tris.shape[0]))
+    rgb = np.full((height, width), background, dtype=np.uint16)
+    depth = np.full((height, width), np.inf, dtype=ar.dtype)
+    prov = np.full((height, width), -1, dtype=np.int32)
+    if tris.shape[0] == 0:
+        return RasterResult(rgb, depth.astype(np.float32), prov, stats)
+
+    cam = to_camera(ar, np.asarray(tris, dtype=ar.dtype), view)
+    scr = screen_triangles(ar, cam, view, size, rules)
+    stats.clipped, stats.rejected, stats.nonfinite = scr.clipped, scr.rejected, scr.nonfinite
+    sub, parent, fx, fy = scr.camera, scr.parent, scr.x, scr.y
+
+    # Draw order: table order for the z-buffer, centroid distance descending for painter.
+    if depth_mode == "painter":
+        key = centroid_sq_distance(ar, cam)
+        order = np.argsort(-key.astype(np.float64), kind="stable")
+        rank_of = np.empty_like(order)
+        rank_of[order] = np.arange(order.size)
+    else:
+        rank_of = np.arange(tris.shape[0])
+    rank = rank_of[parent]
+
+    planes = _depth_planes(cam, parent, sub)
+    ray = _pixel_rays(view, width, height)
+    cov = spans(fx, fy, width, height, rules.subpixel_bits, rules.centre_samples, rules.fill_rule)
+    best_rank = np.full(height * width, -1, dtype=np.int64)
+    best_depth = depth.reshape(-1)
+    for part in _batches(cov):
+        span, col, row = fragments(part)
+        t = part.tri[span]
+        w, dist = _fragment_depth(planes, t, col, row, ray)
+        d = ar.round(dist)
+        if np.isfinite(view.far):
+            inside = w <= view.far
+            d, t, col, row = d[inside], t[inside], col[inside], row[inside]
+        col = col + rules.column_offset
+        on = col < width
+        d, t, col, row = d[on], t[on], col[on], row[on]
+        stats.fragments += int(t.size)
+        _resolve(depth_mode, row * width + col, d, rank[t], best_depth, best_rank)
+
+    hit = best_rank >= 0
+    tri_of_rank = np.empty(tris.shape[0], dtype=np.int64)
+    tri_of_rank[rank_of] = np.arange(tris.shape[0])
+    winner = tri_of_rank[best_rank[hit]]
+    rgb.reshape(-1)[hit] = np.asarray(colours, dtype=np.uint16)[winner]
+    prov.reshape(-1)[hit] = winner
+    return RasterResult(rgb, best_depth.reshape(height, width).astype(np.float32), prov, stats)
+
+
+def _clip_planes(ar: Arith, view: RasterView, width: int, height: int) -> ClipPlanes:
+    # |px - W/2| <= G*W  <=>  |x| / (-z) <= G * canvas_w / near (likewise y).
+    g = _GUARD_SCREENS
+    return ClipPlanes(
+        near=ar.const(view.near),
+        gx=ar.const(g * view.canvas[0] / view.near),
+        gy=ar.const(g * view.canvas[1] / view.near),
+    )
+
+
+@dataclass(frozen=True)
+class _Planes:
+    """Per (sub)triangle: camera-space plane ``n.p = num`` and its vertices' ``-z`` range."""
+
+    n: np.ndarray
+    num: np.ndarray
+    wmin: np.ndarray
+    wmax: np.ndarray
+
+
+def _depth_planes(cam: np.ndarray, parent: np.ndarray, sub: np.ndarray) -> _Planes:
+    v = cam.astype(np.float64)
+    n = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+    num = np.einsum("ij,ij->i", n, v[:, 0])
+    w = -sub[..., 2].astype(np.float64)
+    return _Planes(n[parent], num[parent], w.min(axis=1), w.max(axis=1))
+
+
+@dataclass(frozen=True)
+class _Rays:
+    """Camera-space pixel ray directions (u, v, -1) through the sample points."""
+
+    u: np.ndarray  # (W,)
+    v: np.ndarray  # (H,)
+    length: np.ndarray  # (H, W)
+
+
+def _pixel_rays(view: RasterView, width: int, height: int) -> _Rays:
+    # Inverse of the projection: x/(-z) = (px/W - 0.5) * canvas_w / near.
+    u = ((np.arange(width) + 0.5) / width - 0.5) * view.canvas[0] / view.near
+    v = (0.5 - (np.arange(height) + 0.5) / height) * view.canvas[1] / view.near
+    length = np.sqrt(u[None, :] ** 2 + v[:, None] ** 2 + 1.0)
+    return _Rays(u, v, length)
+
+
+def _fragment_depth(
+    p: _Planes, t: np.ndarray, col: np.ndarray, row: np.ndarray, ray: _Rays
+) -> tuple[np.ndarray, np.ndarray]:
+    """Camera depth ``-z`` and eye distance of each fragment's point on its triangle's plane.
+
+    The ray through the sample is ``s * (u, v, -1)``; it meets the plane at
+    ``s = num / (n . (u, v, -1))``, clamped to the triangle's depth range (which also
+    settles edge-on planes, where the quotient is not finite).
+    """
+    n = p.n[t]
+    den = n[:, 0] * ray.u[col] + n[:, 1] * ray.v[row] - n[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = p.num[t] / den
+    lo, hi = p.wmin[t], p.wmax[t]
+    w = np.clip(np.where(np.isfinite(w), w, hi), lo, hi)
+    return w, w * ray.length[row, col]
+
+
+def _batches(cov):
+    """Split spans so that each batch expands to at most ``_BATCH_FRAGMENTS`` pixels."""
+    n = cov.hi - cov.lo + 1
+    ends = np.cumsum(n)
+    start = 0
+    while start < n.size:
+        base = ends[start - 1] if start else 0
+        stop = max(int(np.searchsorted(ends, base + _BATCH_FRAGMENTS, side="right")), start + 1)
+        yield type(cov)(cov.tri[start:stop], cov.row[start:stop], cov.lo[start:stop], cov.hi[start:stop])
+        start = stop
+
+
+def _resolve(mode: str, pix: np.ndarray, d: np.ndarray, rank: np.ndarray, best_depth: np.ndarray, best_rank: np.ndarray) -> None:
+    """Merge one batch of fragments into the frame's depth and rank buffers."""
+    if mode == "painter":
+        # Later in draw order wins: the highest rank.
+        cand = np.full(best_rank.shape, -1, dtype=np.int64)
+        np.maximum.at(cand, pix, rank)
+        won = cand > best_rank
+        sel = (cand[pix] == rank) & won[pix]
+        best_rank[won] = cand[won]
+        best_depth[pix[sel]] = d[sel]
+        return
+    # z-buffer: nearest wins; equal depths go to the earlier triangle (lower rank).
+    cand_d = np.full(best_depth.shape, np.inf, dtype=best_depth.dtype)
+    np.minimum.at(cand_d, pix, d)
+    at_min = d == cand_d[pix]
+    cand_r = np.full(best_rank.shape, np.iinfo(np.int64).max, dtype=np.int64)
+    np.minimum.at(cand_r, pix[at_min], rank[at_min])
+    won = (cand_r != np.iinfo(np.int64).max) & (
+        (cand_d < best_depth) | ((cand_d == best_depth) & ((best_rank < 0) | (cand_r < best_rank)))
+    )
+    best_depth[won] = cand_d[won]
+    best_rank[won] = cand_r[won]

@@ -16,6 +16,8 @@ from .errors import Rend3rError
 
 #: command name -> ("module:attribute", one-line help shown by ``rend3r --help``)
 COMMANDS: dict[str, tuple[str, str]] = {
+    "device": ("rend3r.transport.cli:device_command", "Virtual device: receive programs over Ethernet or serial, render them to PNGs."),
+    "send": ("rend3r.transport.cli:send_command", "Send a program to a device (Ethernet, serial) or a file (mem, coe, pcap)."),
     "disasm": ("rend3r.asm.cli_disasm:disasm_command", "Disassemble a memory image (mem, bin, coe, ihex, lst) to source."),
 }
 

@@ -83,10 +83,14 @@ class SerialLink(Link):
         self.line_rate = line_rate
         self._buf = bytearray()
         self._line_free = 0.0
+        self._sent = False
         self.tx_bytes = self.rx_bytes = 0
 
     def send(self, frame: bytes) -> None:
         data = cobs.encode(frame) + b"\0"
+        if not self._sent:  # a leading delimiter ends whatever noise the line held before
+            data = b"\0" + data
+            self._sent = True
         self.write(data)
 
     def write(self, data: bytes) -> None:

@@ -1,11 +1,9 @@
-"""Fixtures for transport tests: a null-modem pair of real ptys, network-namespace checks."""
+"""Fixtures for transport tests: a null-modem pair of real ptys."""
 
 from __future__ import annotations
 
 import os
 import select
-import shutil
-import subprocess
 import threading
 import tty
 
@@ -58,16 +56,3 @@ def pty_bridge():
     bridge = PtyBridge()
     yield bridge
     bridge.close()
-
-
-def netns_available() -> str | None:
-    """None if ``unshare -rn`` can create a veth pair here, else the reason it cannot."""
-    if shutil.which("unshare") is None or shutil.which("ip") is None:
-        return "needs unshare(1) and ip(8)"
-    probe = subprocess.run(
-        ["unshare", "-rn", "sh", "-c", "ip link add v0 type veth peer name v1"],
-        capture_output=True, text=True, timeout=30,
-    )
-    if probe.returncode != 0:
-        return f"cannot create a veth pair in a user+network namespace: {probe.stderr.strip()}"
-    return None

@@ -1,0 +1,88 @@
+"""The virtual device's execute step: run the committed program in the emulator, save PNGs.
+
+Rendering runs in a worker thread so the device keeps answering frames while it renders;
+starting a new program (or stopping) supersedes the running one at its next frame.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+import threading
+import time
+from pathlib import Path
+
+from ..errors import Rend3rError
+
+log = logging.getLogger("rend3r.device")
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``WxH`` to (width, height); Rend3rError if malformed."""
+    m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
+    if not m or not (0 < int(m[1]) <= 4096 and 0 < int(m[2]) <= 4096):
+        raise Rend3rError(f"malformed size {text!r}: expected WxH like 128x96 (1..4096 each)")
+    return int(m[1]), int(m[2])
+
+
+def render_frames(words: tuple[int, ...], width: int, height: int, max_frames: int):
+    """The frames the emulator renders for ``words`` (at most ``max_frames``)."""
+    from ..emu import EmuOptions, run_program
+
+    return run_program(list(words), EmuOptions(width=width, height=height), frames=max_frames)
+
+
+class RenderExecutor:
+    """Runs each program it is given in the emulator and writes its frames to ``out``."""
+
+    def __init__(self, out: Path, *, width: int, height: int, max_frames: int,
+                 max_frame_rate: float) -> None:
+        self.out = out
+        self.size = (width, height)
+        self.max_frames = max_frames
+        self.interval = 1.0 / max_frame_rate
+        self.frames = 0
+        self.runs = 0
+        self._lock = threading.Lock()
+        self._cancel = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._next_frame_at = 0.0
+
+    def start(self, words: tuple[int, ...]) -> None:
+        with self._lock:
+            self._cancel.set()
+            self._cancel = threading.Event()
+            self.runs += 1
+            self._thread = threading.Thread(
+                target=self._run, args=(words, self.runs, self._cancel), daemon=True,
+                name=f"render-{self.runs}",
+            )
+            self._thread.start()
+
+    def stop(self) -> None:
+        with self._lock:
+            self._cancel.set()
+
+    def reset(self) -> None:
+        self.stop()
+        self.frames = 0
+
+    def close(self, wait: float = 5.0) -> None:
+        """Stop and wait (bounded) for the worker to finish the frame it is on."""
+        self.stop()
+        if self._thread is not None:
+            self._thread.join(wait)
+
+    def _run(self, words: tuple[int, ...], run: int, cancel: threading.Event) -> None:
+        from ..emu.image import save_png
+
+        try:
+            for frame in render_frames(words, *self.size, self.max_frames):
+                delay = self._next_frame_at - time.monotonic()
+                if cancel.wait(max(0.0, delay)):
+                    return
+                save_png(frame, self.out / f"run{run:04d}_frame{frame.number:04d}.png")
+                self._next_frame_at = time.monotonic() + self.interval
+                self.frames += 1
+        except Rend3rError as exc:
+            log.warning("program of run %d stopped: %s", run, exc)

@@ -1,0 +1,596 @@
+"""The assembler: source text to a :class:`Program`, with every diagnostic of the run.
+
+Lines are read one at a time: the fast path (:mod:`.fastpath`) encodes plain
+instruction lines, everything else goes through the Lark grammar (:mod:`.parser`) and is
+checked here against :mod:`rend3r.isa.tables`. Statements run as soon as they are read,
+except inside a ``.rept`` block, whose body is collected and then run once per iteration.
+"""
+
+from __future__ import annotations
+
+import difflib
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable
+
+from ..errors import Rend3rError
+from ..isa.encoding import CameraSet, FrameOp, LightSet, ShapeSet, encode
+from ..isa.float16 import round_literal, shortest_repr
+from ..isa.tables import (
+    F_MNEMONICS,
+    LIGHT_INDEX_LIMIT,
+    MNEMONIC_TABLE,
+    PROPERTIES,
+    SHAPE_INDEX_LIMIT,
+    Property,
+    Table,
+    ValueType,
+    lookup,
+)
+from ..isa.targets import TARGETS, Target
+from .diagnostics import ERROR, WARNING, Diagnostic, format_all
+from .expressions import POISON, EvalError, Value, evaluate
+from .fastpath import fast_line
+from .parser import Assignment, Directive, Instruction, Operand, Ref, Statement, Str, SyntaxProblem, parse_line
+from .program import Emitted, Program, SourceLoc
+
+#: Statements run (after .rept expansion) before the assembler gives up on a program.
+MAX_STATEMENTS = 1 << 20
+WORD_LIMIT = 1 << 32
+
+MNEMONICS = (*F_MNEMONICS, *MNEMONIC_TABLE)
+DIRECTIVES = (".include", ".rept", ".endr", ".word")
+_OPERANDS = {"cam": "PROP, VALUE", "lt": "INDEX, PROP, VALUE", "sp": "INDEX, PROP, PROP2, VALUE, VALUE2"}
+_OPERANDS["tr"] = _OPERANDS["sp"]
+_REGISTER = re.compile(r"a(\d+)", re.IGNORECASE)
+
+
+@dataclass
+class AssemblyResult:
+    """What one assembler run produced."""
+
+    program: Program
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    mnemonics_used: set[str] = field(default_factory=set)
+
+    @property
+    def ok(self) -> bool:
+        """True when there are no errors (warnings allowed)."""
+        return not any(d.is_error for d in self.diagnostics)
+
+    @property
+    def errors(self) -> list[Diagnostic]:
+        return [d for d in self.diagnostics if d.is_error]
+
+    @property
+    def warnings(self) -> list[Diagnostic]:
+        return [d for d in self.diagnostics if not d.is_error]
+
+    def format_diagnostics(self) -> str:
+        """Every diagnostic with its source line and caret, then a summary line."""
+        return format_all(self.diagnostics)
+
+
+class _Abort(Exception):
+    """Stop assembling (the program is too large to expand)."""
+
+
+@dataclass
+class _Stmt:
+    stmt: Statement
+    file: str
+    line: int
+    text: str
+
+
+@dataclass
+class _Fixed:
+    """A fast-path line: its words are known without evaluation."""
+
+    mnemonic: str
+    words: tuple[int, ...]
+    loc: SourceLoc
+    text: str
+
+
+@dataclass
+class _Rept:
+    stmt: Directive
+    file: str
+    line: int
+    text: str
+    body: list = field(default_factory=list)
+
+
+def resolve_target(target: str | Target | None) -> Target | None:
+    """A Target from its name (see :data:`rend3r.isa.targets.TARGETS`)."""
+    if target is None or isinstance(target, Target):
+        return target
+    try:
+        return TARGETS[target]
+    except KeyError:
+        raise Rend3rError(f"unknown target '{target}' (known: {', '.join(sorted(TARGETS))})") from None
+
+
+class Assembler:
+    """One assembler run; use :func:`assemble_source` or :func:`assemble_file`."""
+
+    def __init__(self, include_paths: Iterable[str | os.PathLike[str]] = (), target: str | Target | None = None,
+                 fast: bool = True) -> None:
+        self.include_paths = [Path(p) for p in include_paths]
+        self.target = resolve_target(target)
+        self.limits = (
+            {"lt": self.target.lights, "sp": self.target.shapes, "tr": self.target.triangles} if self.target else None
+        )
+        self.fast = fast
+        self.entries: list[Emitted] = []
+        self.address = 0
+        self.diagnostics: list[Diagnostic] = []
+        self._seen: set[tuple] = set()
+        self.mnemonics: set[str] = set()
+        self.env: dict[str, Value] = {}
+        self.defined_at: dict[str, str] = {}
+        self.scopes: list[list[str]] = []  # constants defined in each running .rept iteration
+        self.include_stack: list[Path] = []
+        self.statements = 0
+        # where the statement being run comes from: file, line, text, context
+        self.where: tuple[str, int, str, tuple[str, ...]] = ("", 0, "", ())
+
+    # -- diagnostics -------------------------------------------------------------------
+
+    def report(self, severity: str, message: str, col: int = 1, end: int = 0) -> None:
+        file, line, text, context = self.where
+        key = (severity, message, file, line, col)
+        if key in self._seen:
+            return  # the same problem on every .rept iteration is reported once
+        self._seen.add(key)
+        self.diagnostics.append(Diagnostic(severity, message, file, line, col, end, text, context))
+
+    def error(self, message: str, col: int = 1, end: int = 0) -> None:
+        self.report(ERROR, message, col, end)
+
+    def warning(self, message: str, col: int = 1, end: int = 0) -> None:
+        self.report(WARNING, message, col, end)
+
+    # -- reading -----------------------------------------------------------------------
+
+    def run_text(self, text: str, file: str, context: tuple[str, ...] = ()) -> None:
+        """Read and run ``text`` as the lines of ``file``."""
+        open_repts: list[_Rept] = []
+        body: list | None = None  # where statements go while a .rept is open
+        fast = self.fast
+        limits = self.limits
+        entries = self.entries
+        for lineno, line in enumerate(text.split("\n"), 1):
+            if line.endswith("\r"):
+                line = line[:-1]
+            hit = fast_line(line, limits) if fast else None
+            if hit is not None:
+                if not hit:
+                    continue
+                mnemonic, words, col = hit
+                loc = SourceLoc(file, lineno, col)
+                if body is None:
+                    self.count_statement()
+                    entries.append(Emitted(self.address, words, loc, line))
+                    self.address += len(words)
+                    self.mnemonics.add(mnemonic)
+                else:
+                    body.append(_Fixed(mnemonic, words, loc, line))
+                continue
+            self.where = (file, lineno, line, context)
+            try:
+                stmt = parse_line(line)
+            except SyntaxProblem as p:
+                self.error(p.message, p.col, p.end)
+                continue
+            if stmt is None:
+                continue
+            kind = stmt.name.lower() if isinstance(stmt, Directive) else ""
+            if kind == ".rept":
+                node = _Rept(stmt, file, lineno, line)
+                if body is not None:
+                    body.append(node)
+                open_repts.append(node)
+                body = node.body
+            elif kind == ".endr":
+                if stmt.args:
+                    self.error(".endr takes no operands", stmt.args[0].col, stmt.args[-1].end)
+                if not open_repts:
+                    self.error(".endr without a .rept", stmt.col, stmt.end)
+                    continue
+                done = open_repts.pop()
+                if open_repts:
+                    body = open_repts[-1].body
+                else:
+                    body = None
+                    self.run_rept(done, context)
+            elif body is not None:
+                body.append(_Stmt(stmt, file, lineno, line))
+            else:
+                self.run_statement(_Stmt(stmt, file, lineno, line), context)
+        for node in open_repts:
+            self.where = (node.file, node.line, node.text, context)
+            self.error(".rept without a matching .endr", node.stmt.col, node.stmt.end)
+
+    def count_statement(self) -> None:
+        self.statements += 1
+        if self.statements > MAX_STATEMENTS:
+            file, line, _, _ = self.where
+            self.where = (file, line, "", ())
+            self.error(f"program too large: more than {MAX_STATEMENTS} statements after .rept expansion")
+            raise _Abort
+
+    # -- running -----------------------------------------------------------------------
+
+    def run_item(self, item: _Fixed | _Stmt | _Rept, context: tuple[str, ...]) -> None:
+        if isinstance(item, _Fixed):
+            self.count_statement()
+            self.emit(item.mnemonic, item.words, item.loc, item.text)
+        elif isinstance(item, _Rept):
+            self.run_rept(item, context)
+        else:
+            self.run_statement(item, context)
+
+    def emit(self, mnemonic: str, words: tuple[int, ...], loc: SourceLoc, text: str) -> None:
+        self.entries.append(Emitted(self.address, words, loc, text))
+        self.address += len(words)
+        if mnemonic:
+            self.mnemonics.add(mnemonic)
+
+    def run_rept(self, node: _Rept, context: tuple[str, ...]) -> None:
+        self.where = (node.file, node.line, node.text, context)
+        self.count_statement()
+        args = node.stmt.args
+        if not 1 <= len(args) <= 2:
+            self.error(".rept takes COUNT[, VAR]", node.stmt.col, node.stmt.end)
+            return
+        count = self.integer(args[0], "the .rept count", 0, MAX_STATEMENTS)
+        var = self.new_name(args[1], "a .rept variable") if len(args) == 2 else None
+        if count is None or (len(args) == 2 and var is None):
+            return
+        for i in range(count):
+            label = f"{var}={i}" if var else f"#{i}"
+            inner = (f"in .rept iteration {label} ({node.file}:{node.line})", *context)
+            self.scopes.append([])
+            if var:
+                self.define(var, Value(i), f"{node.file}:{node.line}")
+            for item in node.body:
+                self.run_item(item, inner)
+            for name in self.scopes.pop():
+                del self.env[name]
+                del self.defined_at[name]
+
+    def run_statement(self, item: _Stmt, context: tuple[str, ...]) -> None:
+        self.where = (item.file, item.line, item.text, context)
+        self.count_statement()
+        stmt = item.stmt
+        if isinstance(stmt, Instruction):
+            self.instruction(stmt, SourceLoc(item.file, item.line, stmt.col), item.text)
+        elif isinstance(stmt, Assignment):
+            self.assignment(stmt, f"{item.file}:{item.line}")
+        else:
+            self.directive(stmt, item, context)
+
+    # -- names -------------------------------------------------------------------------
+
+    def define(self, name: str, value: Value, where: str) -> None:
+        self.env[name] = value
+        self.defined_at[name] = where
+        if self.scopes:
+            self.scopes[-1].append(name)
+
+    def new_name(self, node: Operand, what: str) -> str | None:
+        """The name ``node`` introduces, or None after reporting why it cannot."""
+        if not isinstance(node, Ref):
+            self.error(f"{what} must be a name", node.col, node.end)
+            return None
+        name = node.name
+        if name.lower() in MNEMONICS:
+            self.error(f"'{name}' is a mnemonic and cannot name {what}", node.col, node.end)
+            return None
+        if name in self.env:
+            self.error(f"'{name}' is already defined (at {self.defined_at[name]})", node.col, node.end)
+            return None
+        return name
+
+    def assignment(self, stmt: Assignment, where: str) -> None:
+        name = self.new_name(Ref(stmt.name, stmt.col, stmt.end), "a constant")
+        if name is None:
+            return
+        try:
+            value = evaluate(stmt.expr, self.env)
+        except EvalError as exc:
+            self.eval_error(exc)
+            value = POISON  # later uses fail quietly instead of as "undefined"
+        self.define(name, value, where)
+
+    def eval_error(self, exc: EvalError) -> None:
+        if exc.message:  # an empty message: the cause was reported already
+            self.error(exc.message, exc.col, exc.end)
+
+    def evaluate(self, node: Operand) -> Value | None:
+        try:
+            return evaluate(node, self.env)
+        except EvalError as exc:
+            self.eval_error(exc)
+            return None
+
+    def integer(self, node: Operand, what: str, lo: int, limit: int) -> int | None:
+        """An integer operand in [lo, limit), or None after reporting why not."""
+        v = self.evaluate(node)
+        if v is None:
+            return None
+        src = self.source(node)
+        if v.raw is not None:
+            self.error(f"{what} must be an integer, not raw bits '{src}'", node.col, node.end)
+            return None
+        if not v.is_integer:
+            self.error(f"{what} must be an integer, got {src} = {float(v.number):g}", node.col, node.end)
+            return None
+        if not lo <= v.number < limit:
+            self.error(f"{what} {v.number} is out of range ({lo}..{limit - 1})", node.col, node.end)
+            return None
+        return v.number
+
+    def source(self, node: Operand) -> str:
+        return self.where[2][node.col - 1 : node.end - 1]
+
+    # -- instructions ------------------------------------------------------------------
+
+    def instruction(self, stmt: Instruction, loc: SourceLoc, text: str) -> None:
+        m = stmt.mnemonic.lower()
+        ops = stmt.operands
+        if m in F_MNEMONICS:
+            if ops:
+                self.error(f"'{m}' takes no operands", ops[0].col, ops[-1].end)
+                return
+            self.emit(m, encode(FrameOp(F_MNEMONICS[m])), loc, text)
+            return
+        table = MNEMONIC_TABLE.get(m)
+        if table is None:
+            close = difflib.get_close_matches(m, MNEMONICS, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            self.error(f"unknown mnemonic '{stmt.mnemonic}'{hint}", stmt.col, stmt.end)
+            return
+        expected = _OPERANDS[m].count(",") + 1
+        if len(ops) != expected:
+            end = ops[-1].end if ops else stmt.end
+            self.error(f"'{m}' takes {expected} operands ({_OPERANDS[m]}), got {len(ops)}", stmt.col, end)
+            return
+        if m == "cam":
+            prop = self.prop(table, ops[0])
+            data = self.data(prop, ops[1]) if prop else None
+            if data is not None:
+                self.emit(m, encode(CameraSet(prop.index, data)), loc, text)
+            return
+        index_limit = LIGHT_INDEX_LIMIT if m == "lt" else SHAPE_INDEX_LIMIT
+        index = self.integer(ops[0], f"{table.value} index", 0, index_limit)
+        if index is not None:
+            self.target_index(m, table, index, ops[0])
+        if m == "lt":
+            prop = self.prop(table, ops[1])
+            data = self.data(prop, ops[2]) if prop else None
+            if index is not None and data is not None:
+                self.emit(m, encode(LightSet(index, prop.index, data)), loc, text)
+            return
+        prop, prop2 = self.prop(table, ops[1]), self.prop(table, ops[2])
+        data = self.data(prop, ops[3]) if prop else None
+        data2 = self.data(prop2, ops[4]) if prop2 else None
+        if prop and prop2 and prop.index == prop2.index and prop.vtype is not ValueType.ZERO:
+            self.warning(
+                f"prop and prop2 are both '{prop.name}': the device writes both and the second value wins",
+                ops[1].col,
+                ops[2].end,
+            )
+        if index is not None and data is not None and data2 is not None:
+            self.emit(m, encode(ShapeSet(index, prop.index, prop2.index, data, data2)), loc, text)
+
+    def target_index(self, m: str, table: Table, index: int, node: Operand) -> None:
+        if self.limits and index >= self.limits[m]:
+            size = self.limits[m]
+            self.warning(
+                f"{table.value} index {index} is beyond {self.target.name}'s {size} {table.value} slots "
+                f"(the device aliases it to {index % size})",
+                node.col,
+                node.end,
+            )
+
+    def prop(self, table: Table, node: Operand) -> Property | None:
+        if not isinstance(node, Ref):
+            self.error(f"expected a {table.value} property name, got '{self.source(node)}'", node.col, node.end)
+            return None
+        prop = lookup(table, node.name)
+        if prop is not None:
+            return prop
+        reg = _REGISTER.fullmatch(node.name)
+        if reg:
+            self.error(f"the {table.value} table has no property {reg.group(1)}", node.col, node.end)
+            return None
+        names = [n for p in PROPERTIES[table] for n in (p.name, *p.extra_names)]
+        close = difflib.get_close_matches(node.name.lower(), names, n=1)
+        hint = f"; did you mean '{close[0]}'?" if close else ""
+        self.error(f"unknown {table.value} property '{node.name}'{hint}", node.col, node.end)
+        return None
+
+    def data(self, prop: Property, node: Operand) -> int | None:
+        """The 16 data bits for ``prop`` from ``node``, or None after reporting why not."""
+        v = self.evaluate(node)
+        if v is None:
+            return None
+        if v.raw is not None:
+            return v.raw
+        src = self.source(node)
+        if prop.vtype is ValueType.FLOAT16:
+            return self.float_bits(prop, v, node, src)
+        bits = prop.bits if prop.vtype is ValueType.INT else 16
+        what = f"'{prop.name}'" if prop.vtype is ValueType.INT else "the zero property"
+        if not v.is_integer:
+            self.error(f"{what} takes an integer or 0h raw bits, got {src}", node.col, node.end)
+            return None
+        if not 0 <= v.number < (1 << bits):
+            shown = src if src == str(v.number) else f"{src} = {v.number}"
+            self.error(
+                f"{shown} is out of range for {what} ({bits} bits: 0..{(1 << bits) - 1})",
+                node.col,
+                node.end,
+            )
+            return None
+        return v.number
+
+    def float_bits(self, prop: Property, v: Value, node: Operand, src: str) -> int | None:
+        if v.hex_literal:
+            self.warning(
+                f"{src} is the integer {v.number} for float16 property '{prop.name}'; "
+                f"write 0h{src[2:].replace('_', '').lower()} for raw bits",
+                node.col,
+                node.end,
+            )
+        r = round_literal(v.number, negative=v.negative_zero)
+        if r.overflow:
+            self.error(f"{src} overflows float16 (magnitude must be below 65520; largest finite is 65504)",
+                       node.col, node.end)
+            return None
+        if r.underflow:
+            self.warning(f"{src} underflows to zero in float16 (smallest subnormal is 2^-24, about 5.96e-08)",
+                         node.col, node.end)
+        elif r.relative_error > 0.01:
+            self.warning(f"{src} rounds to {shortest_repr(r.bits)} in float16 ({r.relative_error:.1%} off)",
+                         node.col, node.end)
+        return r.bits
+
+    # -- directives --------------------------------------------------------------------
+
+    def directive(self, stmt: Directive, item: _Stmt, context: tuple[str, ...]) -> None:
+        kind = stmt.name.lower()
+        if kind == ".word":
+            if not stmt.args:
+                self.error(".word takes one or more 32-bit values", stmt.col, stmt.end)
+                return
+            words = [self.integer(a, ".word value", 0, WORD_LIMIT) for a in stmt.args]
+            if None not in words:
+                self.emit("", tuple(words), SourceLoc(item.file, item.line, stmt.col), item.text)
+        elif kind == ".include":
+            if len(stmt.args) != 1 or not isinstance(stmt.args[0], Str):
+                self.error('.include takes one quoted path: .include "file.asm"', stmt.col, stmt.end)
+                return
+            self.include(stmt.args[0], item, context)
+        else:
+            close = difflib.get_close_matches(kind, DIRECTIVES, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            self.error(f"unknown directive '{stmt.name}'{hint}", stmt.col, stmt.end)
+
+    def include(self, arg: Str, item: _Stmt, context: tuple[str, ...]) -> None:
+        base = Path(item.file).parent
+        candidates = [base / arg.text, *(d / arg.text for d in self.include_paths)]
+        path = next((p for p in candidates if p.is_file()), None)
+        if path is None:
+            searched = ", ".join(str(p.parent) for p in candidates)
+            self.error(f"cannot find include file '{arg.text}' (searched: {searched})", arg.col, arg.end)
+            return
+        real = path.resolve()
+        if real in self.include_stack:
+            chain = " -> ".join(p.name for p in [*self.include_stack[self.include_stack.index(real):], real])
+            self.error(f"include cycle: {chain}", arg.col, arg.end)
+            return
+        text = read_source(path, self.error_at(arg))
+        if text is None:
+            return
+        self.include_stack.append(real)
+        try:
+            self.run_text(text, str(path), (f"included from {item.file}:{item.line}", *context))
+        finally:
+            self.include_stack.pop()
+
+    def error_at(self, node: Operand):
+        return lambda message: self.error(message, node.col, node.end)
+
+    # -- whole program -----------------------------------------------------------------
+
+    def finish(self, main_file: str) -> None:
+        """Warnings about the program as a whole."""
+        last = self.entries[-1] if self.entries else None
+        self.where = (main_file, 0, "", ())
+        if last is not None and last.loc is not None:
+            self.where = (last.loc.file, last.loc.line, last.text, ())
+        tail = [e.words for e in self.entries[-2:]]
+        if tail != [(0,), (0,)]:
+            self.warning("program does not end with two 'er' (the device stops at an er followed by a zero word)")
+        words = self.address
+        if self.target and words > self.target.instructions:
+            self.where = (main_file, 0, "", ())
+            self.warning(f"program is {words} words; {self.target.name} holds {self.target.instructions}")
+
+
+def read_source(path: Path, error) -> str | None:
+    """A source file's text, or None after calling ``error(message)``."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        error(f"cannot read '{path}': {exc.strerror or exc}")
+        return None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        error(f"'{path}' is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start})")
+        return None
+
+
+def _result(asm: Assembler, werror: bool) -> AssemblyResult:
+    diagnostics = [d.as_error() for d in asm.diagnostics] if werror else asm.diagnostics
+    return AssemblyResult(Program(asm.entries), diagnostics, asm.mnemonics)
+
+
+def assemble_source(
+    text: str,
+    filename: str = "<input>",
+    include_paths: Iterable[str | os.PathLike[str]] = (),
+    target: str | Target | None = None,
+    *,
+    werror: bool = False,
+    fast: bool = True,
+) -> AssemblyResult:
+    """Assemble source text. ``.include`` paths are relative to ``filename``'s directory
+    (the current directory for ``<input>``), then to each of ``include_paths``.
+    ``fast=False`` parses every line with the full grammar (for testing the fast path).
+    """
+    asm = Assembler(include_paths, target, fast)
+    if filename != "<input>":
+        asm.include_stack.append(Path(filename).resolve())
+    try:
+        asm.run_text(text, filename)
+    except _Abort:
+        pass
+    else:
+        asm.finish(filename)
+    return _result(asm, werror)
+
+
+def assemble_file(
+    path: str | os.PathLike[str],
+    include_paths: Iterable[str | os.PathLike[str]] = (),
+    target: str | Target | None = None,
+    *,
+    werror: bool = False,
+) -> AssemblyResult:
+    """Assemble a source file; a missing or unreadable file is an error diagnostic."""
+    asm = Assembler(include_paths, target)
+    name = str(path)
+    text = read_source(Path(path), lambda message: asm.diagnostics.append(Diagnostic(ERROR, message, name, 0)))
+    if text is None:
+        return _result(asm, werror)
+    return assemble_source(text, name, include_paths, target, werror=werror)
+
+
+def assemble_or_raise(
+    path: str | os.PathLike[str],
+    include_paths: Iterable[str | os.PathLike[str]] = (),
+    target: str | Target | None = None,
+) -> AssemblyResult:
+    """Assemble a file, raising :class:`Rend3rError` with every diagnostic on errors."""
+    result = assemble_file(path, include_paths, target)
+    if not result.ok:
+        raise Rend3rError(result.format_diagnostics())
+    return result

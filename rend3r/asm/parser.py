@@ -1,0 +1,258 @@
+"""Parse one source line into a statement tree with column spans.
+
+The grammar is ``grammar.lark`` (LALR, contextual lexer); a Transformer runs during
+parsing and builds the small node classes below directly, so no Lark tree is kept.
+Columns count from 1; ``end`` is the column just after the node (Lark's ``end_column``).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from fractions import Fraction
+from functools import lru_cache
+from pathlib import Path
+from typing import Union
+
+from lark import Lark, Token, Transformer
+from lark.exceptions import UnexpectedCharacters, UnexpectedToken
+
+#: Longest exponent and digit count accepted in a literal: bounds the work exact
+#: arithmetic can be asked to do (1e4000 is already far beyond float16).
+MAX_EXPONENT = 4000
+MAX_DIGITS = 1000
+
+
+@dataclass(frozen=True, slots=True)
+class Num:
+    """A numeric literal. ``kind`` is dec, hex, bin or raw (raw: ``value`` is the bits);
+    ``error`` is set when the literal is malformed."""
+
+    value: int | Fraction
+    kind: str
+    col: int
+    end: int
+    error: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class Ref:
+    """A name: a property in a property position, otherwise a constant or .rept variable."""
+
+    name: str
+    col: int
+    end: int
+
+
+@dataclass(frozen=True, slots=True)
+class Neg:
+    operand: "Expr"
+    col: int
+    end: int
+
+
+@dataclass(frozen=True, slots=True)
+class BinOp:
+    op: str
+    left: "Expr"
+    right: "Expr"
+    col: int
+    end: int
+
+
+@dataclass(frozen=True, slots=True)
+class Str:
+    """A string operand (only ``.include`` takes one)."""
+
+    text: str
+    col: int
+    end: int
+
+
+Expr = Union[Num, Ref, Neg, BinOp]
+Operand = Union[Num, Ref, Neg, BinOp, Str]
+
+
+@dataclass(frozen=True, slots=True)
+class Instruction:
+    mnemonic: str  # as written
+    col: int
+    end: int
+    operands: tuple[Operand, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Assignment:
+    name: str
+    col: int
+    end: int
+    expr: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class Directive:
+    name: str  # with its dot, as written
+    col: int
+    end: int
+    args: tuple[Operand, ...]
+
+
+Statement = Union[Instruction, Assignment, Directive]
+
+
+class SyntaxProblem(Exception):
+    """A line that does not parse: message and the span to underline."""
+
+    def __init__(self, message: str, col: int, end: int) -> None:
+        super().__init__(message)
+        self.message = message
+        self.col = col
+        self.end = end
+
+
+_DEC = re.compile(r"(?:\d+(?:_\d+)*)?(?:\.(?:\d+(?:_\d+)*)?)?(?:[eE][+-]?\d+(?:_\d+)*)?")
+_DIGITS = {"HEX": ("0123456789abcdefABCDEF", 16), "BIN": ("01", 2), "RAW": ("0123456789abcdefABCDEF", 16)}
+_KIND = {"NUMBER": "dec", "HEX": "hex", "BIN": "bin", "RAW": "raw"}
+
+
+def parse_number(text: str, token_type: str) -> tuple[int | Fraction, str]:
+    """The exact value of a literal token and an error message ('' when well formed).
+
+    Decimal literals give an int when integral, else a Fraction; 0x and 0b give ints;
+    0h gives the raw 16 bits. ``_`` may separate digits (not lead, trail or double).
+    """
+    if token_type == "NUMBER":
+        if not _DEC.fullmatch(text) or not any(c.isdigit() for c in text.split("e")[0].split("E")[0]):
+            return 0, f"malformed number '{text}'"
+        mantissa, _, exponent = text.replace("_", "").lower().partition("e")
+        if exponent and abs(int(exponent)) > MAX_EXPONENT:
+            return 0, f"exponent of '{text}' is out of range (at most {MAX_EXPONENT} in magnitude)"
+        if len(mantissa) > MAX_DIGITS:
+            return 0, f"number '{text[:20]}...' has too many digits (at most {MAX_DIGITS})"
+        value = Fraction(mantissa + ("e" + exponent if exponent else ""))
+        return (value.numerator if value.denominator == 1 else value), ""
+    digits, base = _DIGITS[token_type]
+    body = text[2:]
+    name = {"HEX": "hexadecimal", "BIN": "binary", "RAW": "raw-bits"}[token_type]
+    if not body or body.startswith("_") or body.endswith("_") or "__" in body or any(
+        c not in digits and c != "_" for c in body
+    ):
+        return 0, f"malformed {name} number '{text}'"
+    body = body.replace("_", "")
+    if len(body) > MAX_DIGITS:
+        return 0, f"number '{text[:20]}...' has too many digits (at most {MAX_DIGITS})"
+    if token_type == "RAW" and len(body) > 4:
+        return 0, f"raw bits '{text}' have more than 4 hex digits (16 bits)"
+    return int(body, base), ""
+
+
+class _Builder(Transformer):
+    """Turns parse-tree callbacks into the node classes above (runs inside the parser)."""
+
+    def start(self, children: list) -> Statement | None:
+        return children[0] if children else None
+
+    def instruction(self, children: list) -> Instruction:
+        name = children[0]
+        return Instruction(str(name), name.column, name.end_column, tuple(children[1:]))
+
+    def assignment(self, children: list) -> Assignment:
+        name, _, expr = children
+        return Assignment(str(name), name.column, name.end_column, expr)
+
+    def directive(self, children: list) -> Directive:
+        name = children[0]
+        args = tuple(
+            Str(str(c)[1:-1], c.column, c.end_column) if isinstance(c, Token) else c for c in children[1:]
+        )
+        return Directive(str(name), name.column, name.end_column, args)
+
+    def number(self, children: list) -> Num:
+        (tok,) = children
+        value, error = parse_number(str(tok), tok.type)
+        return Num(value, _KIND[tok.type], tok.column, tok.end_column, error)
+
+    def ref(self, children: list) -> Ref:
+        (tok,) = children
+        return Ref(str(tok), tok.column, tok.end_column)
+
+    def neg(self, children: list) -> Neg:
+        sign, operand = children
+        return Neg(operand, sign.column, operand.end)
+
+    def pos(self, children: list) -> Expr:
+        sign, operand = children
+        return _respan(operand, sign.column, operand.end)
+
+    def paren(self, children: list) -> Expr:
+        left, inner, right = children
+        return _respan(inner, left.column, right.end_column)
+
+    def binop(self, children: list) -> BinOp:
+        left, op, right = children
+        return BinOp(str(op), left, right, left.col, right.end)
+
+
+def _respan(node: Expr, col: int, end: int) -> Expr:
+    """The same expression, underlined over its parentheses or leading '+'."""
+    cls = type(node)
+    fields = {f: getattr(node, f) for f in cls.__dataclass_fields__}
+    fields.update(col=col, end=end)
+    return cls(**fields)
+
+
+@lru_cache(maxsize=1)
+def _parser() -> Lark:
+    grammar = (Path(__file__).with_name("grammar.lark")).read_text(encoding="utf-8")
+    return Lark(grammar, parser="lalr", lexer="contextual", transformer=_Builder(), maybe_placeholders=False)
+
+
+_TOKEN_WORDS = {
+    "NAME": "a name",
+    "NUMBER": "a number",
+    "HEX": "a number",
+    "BIN": "a number",
+    "RAW": "raw bits",
+    "DIRECTIVE": "a directive",
+    "STRING": "a string",
+    "COMMA": "','",
+    "EQUALS": "'='",
+    "PLUS": "'+'",
+    "MINUS": "'-'",
+    "STAR": "'*'",
+    "SLASH": "'/'",
+    "LPAR": "'('",
+    "RPAR": "')'",
+    "$END": "end of line",
+}
+
+
+def _expected(names: set[str]) -> str:
+    words = sorted({_TOKEN_WORDS.get(n, n) for n in names})
+    if len(words) > 1:
+        return ", ".join(words[:-1]) + " or " + words[-1]
+    return words[0] if words else "nothing"
+
+
+def parse_line(text: str) -> Statement | None:
+    """Parse one line (no newline). None for a blank or comment-only line.
+
+    Raises SyntaxProblem with a column span for anything the grammar rejects.
+    """
+    try:
+        return _parser().parse(text)
+    except UnexpectedCharacters as exc:
+        ch = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+        shown = repr(ch) if ch.isprintable() else f"U+{ord(ch):04X}"
+        raise SyntaxProblem(f"unexpected character {shown}", exc.column, exc.column + 1) from None
+    except UnexpectedToken as exc:
+        tok = exc.token
+        names = set(exc.expected)
+        if text[: tok.column or 0].count("(") <= text[: tok.column or 0].count(")"):
+            names.discard("RPAR")  # LALR's expected set lists ')' even with no '(' open
+        expected = _expected(names)
+        if tok.type == "$END":
+            col = len(text.split(";")[0].split("//")[0].rstrip()) + 1
+            raise SyntaxProblem(f"unexpected end of line, expected {expected}", col, col + 1) from None
+        what = f"'{tok}'"
+        raise SyntaxProblem(f"unexpected {what}, expected {expected}", tok.column, tok.end_column) from None

@@ -17,12 +17,23 @@ Pipeline, per frame (see ``docs/raster.md``):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
+from time import perf_counter
+from typing import Callable
 
 import numpy as np
 
+from ..isa import Table
 from .arith import Arith
+from .camera import VIEW_HEIGHT, VIEW_WIDTH, camera_quaternion, _value
+from .frame import Frame
+from .lights import Light, lights_from_scene
+from .options import EmuOptions
 from .raster_clip import ClipPlanes, clip_triangles
-from .raster_cover import fragments, spans
+from .raster_cover import Spans, fragments, spans
+from .raster_shade import flat_colours
+from .scene import Scene, prop_index
+from .stats import FrameStats
 from .vec import Quat, rotate_inverse
 
 DEPTH_MODES = ("zbuffer", "painter")
@@ -120,8 +131,11 @@ def screen_triangles(
     """Clip camera-space triangles (N, 3, 3), project them and snap to the sub-pixel grid."""
     width, height = size
     clipped = clip_triangles(ar, cam, _clip_planes(ar, view, width, height))
-    px, py = project(ar, clipped.vertices, view, width, height)
     one = float(1 << rules.subpixel_bits)
+    if clipped.vertices.shape[0]:
+        px, py = project(ar, clipped.vertices, view, width, height)
+    else:
+        px = py = np.zeros((0, 3), dtype=ar.dtype)
     with np.errstate(invalid="ignore", over="ignore"):
         fx, fy = px.astype(np.float64) * one, py.astype(np.float64) * one
     finite = np.isfinite(fx).all(axis=1) & np.isfinite(fy).all(axis=1)
@@ -190,7 +204,7 @@ def rasterize(
     for part in _batches(cov):
         span, col, row = fragments(part)
         t = part.tri[span]
-        w, dist = _fragment_depth(planes, t, col, row, ray)
+        w, dist = _fragment_depth(planes, part, span, col, row * width + col, ray)
         d = ar.round(dist)
         if np.isfinite(view.far):
             inside = w <= view.far
@@ -208,6 +222,91 @@ def rasterize(
     rgb.reshape(-1)[hit] = np.asarray(colours, dtype=np.uint16)[winner]
     prov.reshape(-1)[hit] = winner
     return RasterResult(rgb, best_depth.reshape(height, width).astype(np.float32), prov, stats)
+
+
+def render_triangles(
+    tris: np.ndarray,
+    colours: np.ndarray,
+    lights: list[Light],
+    view: RasterView,
+    ar: Arith,
+    size: tuple[int, int],
+    depth_mode: str = "zbuffer",
+    background: int = 0,
+    rules: RasterRules = SPEC_RULES,
+    shading: bool = True,
+) -> RasterResult:
+    """Flat-shade triangles (N, 3, 3) with ``lights`` and rasterize them.
+
+    Triangles whose shading meets NaN or infinity are not drawn (counted as non-finite).
+    """
+    tris = np.asarray(tris, dtype=ar.dtype)
+    colours = np.asarray(colours, dtype=np.uint16)
+    bad = np.zeros(tris.shape[0], dtype=bool)
+    if shading and tris.shape[0]:
+        colours, bad = flat_colours(ar, tris, colours, lights)
+    keep = np.flatnonzero(~bad)
+    res = rasterize(tris[keep], colours[keep], view, ar, size, depth_mode, background, rules)
+    res.provenance[res.provenance >= 0] = keep[res.provenance[res.provenance >= 0]]
+    res.stats.triangles = int(tris.shape[0])
+    res.stats.nonfinite += int(bad.sum())
+    return res
+
+
+_VERTEX_PROPS = ("x1", "y1", "z1", "x2", "y2", "z2", "x3", "y3", "z3")
+
+
+def triangles_from_scene(scene: Scene, ar: Arith) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every triangle the program wrote, in index order: (indices, vertices (N,3,3), colours)."""
+    p = [prop_index(Table.TRIANGLE, n) for n in _VERTEX_PROPS]
+    col = prop_index(Table.TRIANGLE, "col")
+    rows = sorted(scene.objects.items())
+    index = np.fromiter((i for i, _ in rows), dtype=np.int64, count=len(rows))
+    bits = np.array([[props.get(k, 0) for k in p] for _, props in rows], dtype=np.uint16).reshape(-1, 3, 3)
+    colours = np.fromiter((props.get(col, 0) for _, props in rows), dtype=np.uint16, count=len(rows))
+    return index, ar.from_bits(bits), colours
+
+
+def view_from_scene(scene: Scene, ar: Arith) -> RasterView:
+    """The spec camera of ``docs/emulator.md`` as the rasterizer needs it.
+
+    The viewport at the near plane is ``(10 * hfov * near, 7.5 * vfov * near)``, the same
+    pixel rays the raytracer casts; zero (unset) near/fov mean the defaults, far 0 no bound.
+    """
+    loc = np.array([ar.from_bits(scene.camera_bits(n)) for n in ("xloc", "yloc", "zloc")], dtype=ar.dtype)
+    near = _value(scene, "nclip", ar, 1.0)
+    hfov, vfov = _value(scene, "hfov", ar, 1.0), _value(scene, "vfov", ar, 1.0)
+    far = float(ar.from_bits(scene.camera_bits("fclip")))
+    canvas = (ar.mul(ar.mul(ar.const(VIEW_WIDTH), hfov), near), ar.mul(ar.mul(ar.const(VIEW_HEIGHT), vfov), near))
+    return RasterView(
+        location=loc,
+        rotation=camera_quaternion(scene, ar),
+        near=float(near),
+        far=np.inf if far == 0.0 else far,
+        canvas=(float(canvas[0]), float(canvas[1])),
+    )
+
+
+def render_frame(
+    scene: Scene, options: EmuOptions, number: int = 0, progress: Callable[[float], None] | None = None
+) -> tuple[Frame, FrameStats]:
+    """Render the scene's triangles (the processor's ``nf`` hook in raster mode)."""
+    start = perf_counter()
+    ar = options.arith
+    index, tris, colours = triangles_from_scene(scene, ar)
+    lights = lights_from_scene(scene, ar)
+    res = render_triangles(
+        tris, colours, lights, view_from_scene(scene, ar), ar, (options.width, options.height),
+        getattr(options, "depth", "zbuffer"), options.background,
+    )
+    prov = np.where(res.provenance >= 0, index[np.maximum(res.provenance, 0)], -1).astype(np.int32)
+    st = FrameStats(
+        number=number, pixels=options.pixels, shapes=len(index), lights=len(lights),
+        nan_tests=res.stats.nonfinite, hits=int((prov >= 0).sum()), seconds=perf_counter() - start,
+    )
+    if progress is not None:
+        progress(1.0)
+    return Frame(number, res.rgb565, res.depth, prov), st
 
 
 def _clip_planes(ar: Arith, view: RasterView, width: int, height: int) -> ClipPlanes:
@@ -247,30 +346,36 @@ class _Rays:
     length: np.ndarray  # (H, W)
 
 
+@lru_cache(maxsize=8)
+def _pixel_rays_cached(cw: float, ch: float, near: float, width: int, height: int) -> _Rays:
+    u = ((np.arange(width) + 0.5) / width - 0.5) * cw / near
+    v = (0.5 - (np.arange(height) + 0.5) / height) * ch / near
+    return _Rays(u, v, np.sqrt(u[None, :] ** 2 + v[:, None] ** 2 + 1.0))
+
+
 def _pixel_rays(view: RasterView, width: int, height: int) -> _Rays:
     # Inverse of the projection: x/(-z) = (px/W - 0.5) * canvas_w / near.
-    u = ((np.arange(width) + 0.5) / width - 0.5) * view.canvas[0] / view.near
-    v = (0.5 - (np.arange(height) + 0.5) / height) * view.canvas[1] / view.near
-    length = np.sqrt(u[None, :] ** 2 + v[:, None] ** 2 + 1.0)
-    return _Rays(u, v, length)
+    return _pixel_rays_cached(view.canvas[0], view.canvas[1], view.near, width, height)
 
 
 def _fragment_depth(
-    p: _Planes, t: np.ndarray, col: np.ndarray, row: np.ndarray, ray: _Rays
+    p: _Planes, part: Spans, span: np.ndarray, col: np.ndarray, pix: np.ndarray, ray: _Rays
 ) -> tuple[np.ndarray, np.ndarray]:
     """Camera depth ``-z`` and eye distance of each fragment's point on its triangle's plane.
 
     The ray through the sample is ``s * (u, v, -1)``; it meets the plane at
     ``s = num / (n . (u, v, -1))``, clamped to the triangle's depth range (which also
-    settles edge-on planes, where the quotient is not finite).
+    settles edge-on planes, where the quotient is not finite). Coefficients are formed
+    once per span and expanded to its pixels.
     """
-    n = p.n[t]
-    den = n[:, 0] * ray.u[col] + n[:, 1] * ray.v[row] - n[:, 2]
+    t = part.tri
+    a = p.n[t, 0]
+    b = p.n[t, 1] * ray.v[part.row] - p.n[t, 2]
     with np.errstate(divide="ignore", invalid="ignore"):
-        w = p.num[t] / den
-    lo, hi = p.wmin[t], p.wmax[t]
+        w = p.num[t][span] / (a[span] * ray.u[col] + b[span])
+    lo, hi = p.wmin[t][span], p.wmax[t][span]
     w = np.clip(np.where(np.isfinite(w), w, hi), lo, hi)
-    return w, w * ray.length[row, col]
+    return w, w * ray.length.reshape(-1)[pix]
 
 
 def _batches(cov):

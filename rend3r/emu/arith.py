@@ -46,11 +46,13 @@ class Arith:
 
     def round(self, x: np.ndarray | float) -> np.ndarray:
         """Round values (already in or above working precision) to the working format."""
-        a = np.asarray(x, dtype=self.dtype)
         if self.precision != "fp16":
-            return a
+            return np.asarray(x, dtype=self.dtype)
+        a = np.asarray(x)
+        if a.dtype == np.float32 and a.ndim:
+            return _round16_f32(a, self.ftz)
         with np.errstate(over="ignore", invalid="ignore"):
-            r = a.astype(np.float16).astype(np.float32)
+            r = a.astype(np.float16).astype(np.float32)  # direct, so no double rounding
         if self.ftz:
             r = np.where(np.abs(r) < _FP16_MIN_NORMAL, np.copysign(np.float32(0), r), r)
         return r
@@ -87,6 +89,41 @@ class Arith:
         """float16 bit patterns (as stored by the ISA) to working-precision values."""
         h = np.asarray(bits, dtype=np.uint16).view(np.float16)
         return self.round(h.astype(self.dtype))
+
+
+_SIGN = np.uint32(0x80000000)
+_MIN_NORMAL_BITS = 0x38800000  # 2**-14 as float32 bits
+_FTZ_UP_BITS = 0x387FE000  # 2**-14 - 2**-25: the subnormal grid rounds it up to 2**-14
+_OVERFLOW_BITS = 0x477FF000  # 65520: rounds to infinity
+_INF_BITS = 0x7F800000
+
+
+def _round16_f32(a: np.ndarray, ftz: bool) -> np.ndarray:
+    """float32 -> nearest-even float16 value, held in float32, by integer operations.
+
+    Rounds the significand to 11 bits in place (normal float16 range), then fixes the rare
+    lanes that overflow, are NaN, or fall in the subnormal range. Equal, bit for bit, to
+    converting through numpy's float16 (tested exhaustively in the sign/exponent bands).
+    """
+    b = a.view(np.uint32)
+    ab = b & np.uint32(0x7FFFFFFF)
+    r = b + (np.uint32(0xFFF) + ((b >> np.uint32(13)) & np.uint32(1)))
+    r &= np.uint32(0xFFFFE000)
+    if ab.max() >= _OVERFLOW_BITS:
+        big = (ab >= _OVERFLOW_BITS) & (ab <= _INF_BITS)
+        r[big] = (b[big] & _SIGN) | np.uint32(_INF_BITS)
+        nan = ab > _INF_BITS
+        r[nan] = b[nan]
+    if ab.min() < _MIN_NORMAL_BITS:
+        small = ab < _MIN_NORMAL_BITS
+        sign = b[small] & _SIGN
+        if ftz:
+            up = ab[small] >= _FTZ_UP_BITS
+            r[small] = sign | np.where(up, np.uint32(_MIN_NORMAL_BITS), np.uint32(0))
+        else:
+            mag = np.abs(a[small]).astype(np.float16).astype(np.float32)
+            r[small] = mag.view(np.uint32) | sign
+    return r.view(np.float32)
 
 
 def make_arith(precision: Precision = "fp16", subnormals: Literal["ftz", "ieee"] = "ftz") -> Arith:

@@ -44,3 +44,29 @@ def test_overflow_is_infinite_not_clamped():
     ar = make_arith("fp16")
     assert np.isinf(ar.mul(ar.const(300.0), ar.const(300.0)))
     assert float(make_arith("fp32").mul(np.float32(300), np.float32(300))) == 90000.0
+
+
+def _reference_round16(a: np.ndarray, ftz: bool) -> np.ndarray:
+    with np.errstate(over="ignore", invalid="ignore"):
+        r = a.astype(np.float16).astype(np.float32)
+    if ftz:
+        r = np.where(np.abs(r) < np.float32(2.0**-14), np.copysign(np.float32(0), r), r)
+    return r
+
+
+def test_fast_float32_rounding_matches_numpy_float16_bit_for_bit():
+    """Every float32 whose exponent lies in or near float16's range, sampled densely."""
+    rng = np.random.default_rng(7)
+    mantissas = rng.integers(0, 1 << 23, 4096, dtype=np.uint32)
+    edges = np.array([0, 1, 0xFFF, 0x1000, 0x1001, 0x1FFF, 0x2000, 0x3000, 0x5FFF, 0x6000, 0x7FE000, 0x7FF000, 0x7FFFFF],
+                     dtype=np.uint32)
+    mant = np.concatenate([mantissas, edges])
+    exps = np.arange(90, 256, dtype=np.uint32)  # 2**-37 .. inf/NaN
+    bits = (exps[:, None] << np.uint32(23)) | mant[None, :]
+    bits = np.concatenate([bits.ravel(), bits.ravel() | np.uint32(0x80000000), np.array([0, 0x80000000], np.uint32)])
+    a = bits.view(np.float32)
+    for ftz in (True, False):
+        ar = make_arith("fp16", "ftz" if ftz else "ieee")
+        got, want = ar.round(a), _reference_round16(a, ftz)
+        same = (got.view(np.uint32) == want.view(np.uint32)) | (np.isnan(got) & np.isnan(want))
+        assert same.all(), hex(int(bits[~same][0]))

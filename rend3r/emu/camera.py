@@ -1,0 +1,112 @@
+"""Primary rays: the spec camera (paper) and the device's fixed camera.
+
+Both return :class:`Rays` in working precision, one ray per pixel in row-major order
+(flat index ``y * width + x``). See ``docs/emulator.md`` for the camera model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from ..isa import Table
+from .arith import Arith
+from .options import EmuOptions
+from .scene import Scene, prop_index
+from .vec import Quat, Vec, rotate
+
+#: The device's ray generator: start values and the step added once per pixel (float16 bits).
+DEVICE_X0, DEVICE_Y0, DEVICE_Z, DEVICE_STEP = 0xC4FD, 0xC37B, 0xBC00, 0x2500
+#: Default viewport of the paper: 10 x 7.5 at near-clip 1.
+VIEW_WIDTH, VIEW_HEIGHT = 10.0, 7.5
+
+
+@dataclass(frozen=True)
+class Rays:
+    """Rays from one origin: ``origin + t * direction`` accepted for ``tmin <= t <= tmax``."""
+
+    origin: Vec  # three 0-d arrays
+    direction: Vec  # three (pixels,) arrays
+    tmin: np.ndarray
+    tmax: np.ndarray
+
+
+def camera_rays(scene: Scene, options: EmuOptions, arith: Arith) -> Rays:
+    """The primary rays of the frame, by the camera model the options select."""
+    origin = tuple(arith.from_bits(scene.camera_bits(n)) for n in ("xloc", "yloc", "zloc"))
+    if options.camera == "device":
+        return _device_rays(origin, options.width, options.height, arith)
+    return _spec_rays(scene, origin, options.width, options.height, arith)
+
+
+@lru_cache(maxsize=16)
+def _device_axis(arith: Arith, start: int, count: int) -> np.ndarray:
+    """start, start+step, ...: each value one float16 addition after the previous one."""
+    step = arith.from_bits(DEVICE_STEP)
+    out = np.empty(count, dtype=arith.dtype)
+    v = arith.from_bits(start)
+    for i in range(count):
+        out[i] = v
+        v = arith.add(v, step)
+    out.flags.writeable = False
+    return out
+
+
+def _device_rays(origin: Vec, width: int, height: int, arith: Arith) -> Rays:
+    """Direction (x0 + x*step, y0 + y*step, -1), unnormalised; row 0 is world y = -3.74."""
+    xs = _device_axis(arith, DEVICE_X0, width)
+    ys = _device_axis(arith, DEVICE_Y0, height)
+    dx = np.broadcast_to(xs[None, :], (height, width)).ravel()
+    dy = np.broadcast_to(ys[:, None], (height, width)).ravel()
+    dz = np.full(width * height, arith.from_bits(DEVICE_Z), dtype=arith.dtype)
+    return Rays(origin, (dx, dy, dz), arith.const(0.0), arith.const(np.inf))
+
+
+def _value(scene: Scene, name: str, arith: Arith, default: float) -> np.ndarray:
+    """A camera property's value; zero (as memory starts) means the default."""
+    v = arith.from_bits(scene.camera.get(prop_index(Table.CAMERA, name), 0))
+    return arith.const(default) if float(v) == 0.0 else v
+
+
+def camera_quaternion(scene: Scene, arith: Arith) -> Quat | None:
+    """The camera's rotation, normalised; None when all four are zero (no rotation)."""
+    q = [arith.from_bits(scene.camera_bits(n)) for n in ("rrot", "irot", "jrot", "krot")]
+    if all(float(c) == 0.0 for c in q):
+        return None
+    r, i, j, k = q
+    norm2 = arith.add(arith.add(arith.mul(r, r), arith.mul(i, i)), arith.add(arith.mul(j, j), arith.mul(k, k)))
+    norm = arith.sqrt(norm2)
+    return tuple(arith.div(c, norm) for c in q)
+
+
+@lru_cache(maxsize=16)
+def _viewport_axes(arith: Arith, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """Default viewport coordinates of pixel centres, each rounded once: x right, y up."""
+    x = (np.arange(width) + 0.5) / width - 0.5
+    y = 0.5 - (np.arange(height) + 0.5) / height
+    ux, uy = arith.round(VIEW_WIDTH * x), arith.round(VIEW_HEIGHT * y)
+    ux.flags.writeable = uy.flags.writeable = False
+    return ux, uy
+
+
+def _spec_rays(scene: Scene, origin: Vec, width: int, height: int, arith: Arith) -> Rays:
+    """Camera space (ux*hfov*n, uy*vfov*n, -n) rotated by q; t = 1 is the near plane."""
+    near = _value(scene, "nclip", arith, 1.0)
+    hfov = _value(scene, "hfov", arith, 1.0)
+    vfov = _value(scene, "vfov", arith, 1.0)
+    ux, uy = _viewport_axes(arith, width, height)
+    cx = arith.mul(arith.mul(ux, hfov), near)
+    cy = arith.mul(arith.mul(uy, vfov), near)
+    shape = (height, width)
+    cam = (
+        np.broadcast_to(cx[None, :], shape).ravel(),
+        np.broadcast_to(cy[:, None], shape).ravel(),
+        np.full(width * height, arith.neg(near), dtype=arith.dtype),
+    )
+    q = camera_quaternion(scene, arith)
+    direction = cam if q is None else rotate(arith, q, cam)
+    far = arith.from_bits(scene.camera_bits("fclip"))
+    tmax = arith.const(np.inf) if float(far) == 0.0 else arith.div(far, near)
+    return Rays(origin, direction, arith.const(1.0), tmax)

@@ -1,0 +1,168 @@
+"""Conservative culling: which (pixel tile, shape) tests can be skipped without effect.
+
+A shape test is skipped only when every ray of the tile provably misses the shape *as the
+working-precision raycaster computes it* (not merely in exact arithmetic). The bound, derived
+in ``docs/emulator.md``: in the shape's normal space the ray line stays farther than
+``sqrt(1 + 24 u (1 + M^2)) + 16 u M (1 + k)`` from the origin, where ``u`` is the unit
+roundoff (float16's, with a flush-to-zero term), ``M`` bounds |S| in normal space and ``k``
+is the condition number of the shape's linear map. Then the computed discriminant is
+negative. Only spheres with moderate scales and rotations are culled; every other shape
+is tested against every pixel.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterator
+
+import numpy as np
+
+from .shapes import Shapes
+
+TILE = 16  # pixels per tile side
+PAIR_CHUNK = 1 << 19  # pixel-shape pairs computed per batch
+U16 = 2.0**-11  # float16 unit roundoff
+FTZ = 2.0**-14  # largest absolute error of one flush to zero
+_SLACK = 1e-9
+
+
+@dataclass(frozen=True)
+class Tiles:
+    """Active pixels grouped by screen tile."""
+
+    order: np.ndarray  # positions into the active-pixel array, tile by tile
+    start: np.ndarray  # per tile: offset into order
+    count: np.ndarray  # per tile: number of active pixels
+    of_pixel: np.ndarray  # per active pixel (in order): its tile number
+
+    def __len__(self) -> int:
+        return len(self.count)
+
+
+def make_tiles(pixels: np.ndarray, width: int) -> Tiles:
+    """Group active pixels (flat indices) into TILE x TILE screen tiles (empty ones dropped)."""
+    tx, ty = (pixels % width) // TILE, (pixels // width) // TILE
+    key = ty * ((width + TILE - 1) // TILE) + tx
+    order = np.argsort(key, kind="stable")
+    key = key[order]
+    uniq, start, count = np.unique(key, return_index=True, return_counts=True)
+    return Tiles(order, start, count, np.repeat(np.arange(len(uniq)), count))
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """Per shape: centre, the smallest and largest singular value of its map, cullable."""
+
+    center: np.ndarray  # (n, 3) float64
+    smin: np.ndarray
+    smax: np.ndarray
+    cullable: np.ndarray
+
+
+def shape_bounds(shapes: Shapes) -> Bounds:
+    """The world-to-normal-space map is |q|^2 * diag(s) * R^T: singular values |q|^2 |s_i|."""
+    q2 = sum(np.asarray(c, np.float64) ** 2 for c in shapes.rot)
+    s = np.abs(np.stack([np.asarray(c, np.float64) for c in shapes.inv_scale], axis=1))
+    center = np.stack([np.asarray(c, np.float64) for c in shapes.loc], axis=1)
+    smin, smax = q2 * s.min(axis=1), q2 * s.max(axis=1)
+    with np.errstate(all="ignore"):
+        ok = (shapes.kind == 1) & np.isfinite(center).all(axis=1) & (smin >= 2.0**-6) & (smax <= 2.0**6)
+    return Bounds(center, smin, smax, ok)
+
+
+def cull_radius(b: Bounds, sel: np.ndarray, dist: np.ndarray, dmin: np.ndarray) -> np.ndarray:
+    """World radius beyond which no ray line can hit, for shapes ``sel``.
+
+    ``dist`` bounds the distance from ray origins to the centre, ``dmin`` the direction
+    lengths (both broadcast against ``sel``).
+    """
+    smin, smax = b.smin[sel], b.smax[sel]
+    dhat = smin * dmin  # |D| in normal space, at least
+    u = U16 + FTZ / np.minimum(1.0, dhat * dhat)
+    m = smax * dist
+    h = np.sqrt(1.0 + 24.0 * u * (1.0 + m * m)) + 16.0 * u * m * (1.0 + smax / smin)
+    r = h / smin * (1.0 + _SLACK) + _SLACK
+    return np.where(b.cullable[sel] & (dhat >= 2.0**-4), r, np.inf)
+
+
+def _unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    n = np.linalg.norm(v, axis=-1)
+    with np.errstate(all="ignore"):
+        return v / n[..., None], n
+
+
+def _tile_reduce(tiles: Tiles, values: np.ndarray, op: np.ufunc) -> np.ndarray:
+    """Reduce per-pixel values (in tile order) to one value per tile."""
+    return op.reduceat(values, tiles.start, axis=0)
+
+
+def cone_keep(tiles: Tiles, apex: np.ndarray, dirs: np.ndarray, origins: np.ndarray | None,
+              b: Bounds, sel: np.ndarray) -> np.ndarray:
+    """(tiles, len(sel)) mask: rays through ``apex`` with the tile's directions may hit.
+
+    ``dirs`` are the rays' directions and ``origins`` their origins (None: the apex
+    itself), per active pixel in tile order.
+    """
+    unit, length = _unit(dirs)
+    axis, _ = _unit(_tile_reduce(tiles, unit, np.add))
+    cos = np.einsum("ij,ij->i", unit, axis[tiles.of_pixel])
+    half = np.arccos(np.clip(_tile_reduce(tiles, cos, np.minimum), -1.0, 1.0)) + 1e-7
+    half = np.where(np.isfinite(axis).all(axis=1), half, np.pi)
+    dmin = _tile_reduce(tiles, length, np.minimum)[:, None]
+    v = b.center[sel] - apex
+    vunit, vlen = _unit(v)
+    dist = _origin_distance(tiles, origins, b.center[sel]) if origins is not None else vlen[None, :]
+    r = cull_radius(b, sel, dist, dmin)
+    phi = np.arccos(np.clip(axis @ vunit.T, -1.0, 1.0))
+    phi = np.minimum(phi, np.pi - phi)  # lines, not half-lines
+    with np.errstate(all="ignore"):
+        spread = np.arcsin(np.clip(r / vlen[None, :], 0.0, 1.0))
+    return (vlen[None, :] <= r) | (phi <= half[:, None] + spread + 1e-7) | ~np.isfinite(r)
+
+
+def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: Bounds, sel: np.ndarray) -> np.ndarray:
+    """(tiles, len(sel)) mask: parallel rays from the tile's origins (tile order) may hit."""
+    d, dlen = _unit(direction)
+    e1 = np.cross(d, [1.0, 0.0, 0.0] if abs(d[0]) < 0.9 else [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(d, e1)
+    basis = np.stack([e1, e2], axis=1)
+    p2 = origins @ basis
+    lo = _tile_reduce(tiles, p2, np.minimum)
+    hi = _tile_reduce(tiles, p2, np.maximum)
+    c2 = b.center[sel] @ basis
+    gap = np.maximum(0.0, np.maximum(lo[:, None, :] - c2[None], c2[None] - hi[:, None, :]))
+    dist = _origin_distance(tiles, origins, b.center[sel])
+    r = cull_radius(b, sel, dist, np.full((len(tiles), 1), dlen))
+    return (np.linalg.norm(gap, axis=2) <= r) | ~np.isfinite(r)
+
+
+def _origin_distance(tiles: Tiles, origins: np.ndarray, centers: np.ndarray) -> np.ndarray:
+    """(tiles, shapes): an upper bound of |origin - centre| over each tile's origins."""
+    lo = _tile_reduce(tiles, origins, np.minimum)
+    hi = _tile_reduce(tiles, origins, np.maximum)
+    mid, half = (lo + hi) / 2, np.linalg.norm(hi - lo, axis=1) / 2
+    return np.linalg.norm(centers[None] - mid[:, None], axis=2) + half[:, None]
+
+
+def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """(active position, shape position) pairs of the kept (tile, shape) cells, in batches."""
+    ti, si = np.nonzero(keep)
+    counts = tiles.count[ti]
+    ends = np.cumsum(counts)
+    lo = 0
+    while lo < len(ti):
+        hi = int(np.searchsorted(ends, (ends[lo - 1] if lo else 0) + PAIR_CHUNK, side="right"))
+        hi = max(hi, lo + 1)
+        c = counts[lo:hi]
+        total = int(c.sum())
+        first = np.repeat(tiles.start[ti[lo:hi]] - np.concatenate(([0], np.cumsum(c)[:-1])), c)
+        yield tiles.order[first + np.arange(total)], np.repeat(sel[si[lo:hi]], c)
+        lo = hi
+
+
+def shape_blocks(n: int, tiles: int) -> Iterator[np.ndarray]:
+    """Shape positions in blocks that keep a (tiles, block) matrix modest."""
+    step = max(1, (1 << 21) // max(1, tiles))
+    for lo in range(0, n, step):
+        yield np.arange(lo, min(n, lo + step))

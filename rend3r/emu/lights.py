@@ -1,0 +1,46 @@
+"""Lights that are on, read from the scene through the light property table."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..isa import Table
+from .arith import Arith
+from .scene import Scene, prop_index
+from .vec import Vec
+
+DIRECTIONAL, POINT = 1, 2
+WHITE = 0xFFFF
+#: Unset (never written since the last nr) colour and intensity: white at full strength.
+DEFAULT_INTENSITY = 1.0
+
+
+@dataclass(frozen=True)
+class Light:
+    index: int
+    kind: int  # DIRECTIONAL or POINT
+    location: Vec
+    forward: Vec
+    color: int  # RGB565
+    intensity: np.ndarray
+
+
+def lights_from_scene(scene: Scene, arith: Arith) -> list[Light]:
+    """Lights whose ``src`` low two bits say directional (1) or point (2), in index order."""
+    p = {n: prop_index(Table.LIGHT, n) for n in (
+        "src", "xloc", "yloc", "zloc", "xfor", "yfor", "zfor", "col", "int")}
+    out = []
+    for index in sorted(scene.lights):
+        props = scene.lights[index]
+        kind = props.get(p["src"], 0) & 3
+        if kind not in (DIRECTIONAL, POINT):
+            continue
+        v = lambda n: arith.from_bits(props.get(p[n], 0))  # noqa: E731
+        out.append(Light(
+            index, kind, (v("xloc"), v("yloc"), v("zloc")), (v("xfor"), v("yfor"), v("zfor")),
+            props.get(p["col"], WHITE),
+            v("int") if p["int"] in props else arith.const(DEFAULT_INTENSITY),
+        ))
+    return out

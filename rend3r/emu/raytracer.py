@@ -1,0 +1,189 @@
+"""The raytracer: nearest hit per pixel, diffuse lighting, shadow rays, NaN accounting.
+
+Work is done on (pixel, shape) pairs in batches; :mod:`.cull` drops pairs that provably
+cannot change a pixel. Colour arithmetic (after the float16 datapath): see
+``docs/emulator.md``.
+"""
+
+from __future__ import annotations
+
+from time import perf_counter
+from typing import Callable
+
+import numpy as np
+
+from .arith import Arith
+from .camera import camera_rays
+from .cull import Bounds, Tiles, cone_keep, make_tiles, pairs, parallel_keep, shape_blocks, shape_bounds
+from .frame import Frame
+from .lights import POINT, Light, lights_from_scene
+from .options import EmuOptions
+from .scene import Scene
+from .shapes import Shapes, origin_term, shapes_from_scene, solve, squared_distance, surface, to_object
+from .stats import FrameStats
+from .vec import Vec, dot, sub3
+
+Progress = Callable[[float], None]
+_NONE = np.iinfo(np.int64).max
+
+
+def _f64(v: Vec) -> np.ndarray:
+    """(n, 3) float64 view of a vector for culling geometry."""
+    return np.stack(np.broadcast_arrays(*[np.atleast_1d(np.asarray(c, np.float64)) for c in v]), axis=-1)
+
+
+def _take(v: Vec, idx: np.ndarray) -> Vec:
+    return tuple(c[idx] if np.ndim(c) else c for c in v)
+
+
+class _Nearest:
+    """Running nearest hit per pixel: smallest squared distance, ties to the lower index."""
+
+    def __init__(self, n: int, dtype: type) -> None:
+        self.sqd = np.full(n, np.inf, dtype=dtype)
+        self.slot = np.full(n, _NONE, dtype=np.int64)
+
+    def update(self, pix: np.ndarray, slot: np.ndarray, sqd: np.ndarray) -> None:
+        before = self.sqd[pix]
+        np.minimum.at(self.sqd, pix, sqd)
+        now = self.sqd[pix]
+        self.slot[pix[now < before]] = _NONE
+        tie = sqd == now
+        np.minimum.at(self.slot, pix[tie], slot[tie])
+
+
+def render_frame(
+    scene: Scene, options: EmuOptions, number: int = 0, progress: Progress | None = None
+) -> tuple[Frame, FrameStats]:
+    """Render the scene as the raytracer sees it; returns the frame and its stats."""
+    start = perf_counter()
+    ar = options.arith
+    w, h, n_pix = options.width, options.height, options.pixels
+    rays = camera_rays(scene, options, ar)
+    shapes = shapes_from_scene(scene, ar)
+    lights = lights_from_scene(scene, ar)
+    st = FrameStats(number=number, pixels=n_pix, shapes=len(shapes), lights=len(lights), rays=n_pix)
+    rgb = np.full(n_pix, options.background, dtype=np.uint16)
+    depth = np.full(n_pix, np.inf, dtype=np.float32)
+    prov = np.full(n_pix, -1, dtype=np.int32)
+    nan_pixel = np.zeros(n_pix, dtype=bool)
+    if len(shapes):
+        bounds = shape_bounds(shapes)
+        dd = dot(ar, rays.direction, rays.direction)
+        near = _primary(ar, options, rays, dd, shapes, bounds, st, nan_pixel, progress)
+        hp = np.nonzero(near.slot != _NONE)[0]
+        slot = near.slot[hp]
+        s = shapes.take(slot)
+        D = _take(rays.direction, hp)
+        S, Dh = to_object(ar, s, rays.origin, D)
+        sol = solve(ar, s, S, Dh, origin_term(ar, s, S), rays.tmin, rays.tmax)
+        point, normal = surface(ar, s, S, Dh, sol.t, rays.origin, D)
+        color, bad = _shade(ar, options, shapes, bounds, lights, hp, slot, point, normal, st, nan_pixel)
+        nan_pixel[hp[bad]] = True
+        hp, slot = hp[~bad], slot[~bad]
+        rgb[hp] = color[~bad]
+        depth[hp] = np.sqrt(near.sqd[hp].astype(np.float64))
+        prov[hp] = shapes.index[slot]
+        st.hits = len(hp)
+    st.nan_rays = int(nan_pixel.sum())
+    st.seconds = perf_counter() - start
+    frame = Frame(number, rgb.reshape(h, w), depth.reshape(h, w), prov.reshape(h, w))
+    return frame, st
+
+
+def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: Bounds,
+             st: FrameStats, nan_pixel: np.ndarray, progress: Progress | None) -> _Nearest:
+    """Nearest hit of every primary ray; the ray origin's normal-space terms are per shape."""
+    n_pix = options.pixels
+    near = _Nearest(n_pix, ar.dtype)
+    S_shape, _ = to_object(ar, shapes, rays.origin, None)
+    c2_shape = origin_term(ar, shapes, S_shape)
+    tiles = make_tiles(np.arange(n_pix), options.width)
+    apex = _f64(rays.origin)[0]
+    dirs = _f64(rays.direction)[tiles.order] if options.cull else None
+    blocks = list(shape_blocks(len(shapes), len(tiles)))
+    for done, sel in enumerate(blocks):
+        keep = cone_keep(tiles, apex, dirs, None, bounds, sel) if options.cull else np.ones((len(tiles), len(sel)), bool)
+        for pix, slot in pairs(tiles, keep, sel):
+            s = shapes.take(slot)
+            _, Dh = to_object(ar, s, None, _take(rays.direction, pix))
+            sol = solve(ar, s, _take(S_shape, slot), Dh, c2_shape[slot], rays.tmin, rays.tmax)
+            sqd = squared_distance(ar, dd[pix], sol.t)
+            bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
+            hit = sol.hit & ~bad
+            st.tests += len(pix)
+            st.nan_tests += int(bad.sum())
+            nan_pixel[pix[bad]] = True
+            near.update(pix[hit], slot[hit], sqd[hit])
+        if progress is not None:
+            progress((done + 1) / len(blocks))
+    st.skipped += n_pix * len(shapes) - st.tests
+    return near
+
+
+def _shade(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, lights: list[Light], hp: np.ndarray,
+           slot: np.ndarray, point: Vec, normal: Vec, st: FrameStats, nan_pixel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """RGB565 per hit pixel and a mask of pixels whose shading met NaN or infinity."""
+    base = shapes.color[slot]
+    bad = ~(np.isfinite(point[0]) & np.isfinite(point[1]) & np.isfinite(point[2]))
+    if not lights:
+        return base, bad
+    channels = np.stack([base >> 11, (base >> 5) & 0x3F, base & 0x1F], axis=1).astype(np.float64)
+    acc = np.zeros_like(channels)
+    nn = ar.sqrt(dot(ar, normal, normal))
+    for light in lights:
+        if light.kind == POINT:
+            l_vec = sub3(ar, light.location, point)
+        else:
+            l_vec = tuple(ar.neg(c) for c in light.forward)
+        cos = ar.div(dot(ar, normal, l_vec), ar.mul(nn, ar.sqrt(dot(ar, l_vec, l_vec))))
+        f = ar.mul(cos, light.intensity)
+        finite = np.isfinite(cos) & np.isfinite(f)
+        bad |= ~finite
+        lit = np.nonzero(finite & ~bad & (cos > 0))[0]
+        blocked = _shadowed(ar, options, shapes, bounds, light, _take(point, lit), _take(l_vec, lit),
+                            hp[lit], slot[lit], st, nan_pixel)
+        lit = lit[~blocked]
+        lc = light.color
+        scale = np.array([(lc >> 11) / 31.0, ((lc >> 5) & 0x3F) / 63.0, (lc & 0x1F) / 31.0])
+        acc[lit] += np.asarray(f, np.float64)[lit, None] * channels[lit] * scale
+    ch = np.clip(np.floor(acc + 0.5), 0, [31, 63, 31]).astype(np.uint16)
+    return (ch[:, 0] << 11) | (ch[:, 1] << 5) | ch[:, 2], bad
+
+
+def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, light: Light, origin: Vec,
+              direction: Vec, pix: np.ndarray, own: np.ndarray, st: FrameStats, nan_pixel: np.ndarray) -> np.ndarray:
+    """Whether another shape lies on each shadow ray (t > 0; before the light if a point)."""
+    n = len(pix)
+    blocked = np.zeros(n, dtype=bool)
+    st.shadow_rays += n
+    if n == 0 or len(shapes) < 2:
+        return blocked
+    tmax = ar.const(1.0 if light.kind == POINT else np.inf)
+    tmin = ar.const(0.0)
+    tiles = make_tiles(pix, options.width)
+    before = st.tests
+    if options.cull:
+        org = _f64(origin)[tiles.order]
+        if light.kind == POINT:
+            apex = _f64(light.location)[0]
+            dirs = _f64(direction)[tiles.order]
+    for sel in shape_blocks(len(shapes), len(tiles)):
+        if not options.cull:
+            keep = np.ones((len(tiles), len(sel)), bool)
+        elif light.kind == POINT:
+            keep = cone_keep(tiles, apex, dirs, org, bounds, sel)
+        else:
+            keep = parallel_keep(tiles, _f64(direction)[0], org, bounds, sel)
+        for pos, slot in pairs(tiles, keep, sel):
+            other = slot != own[pos]
+            pos, slot = pos[other], slot[other]
+            s = shapes.take(slot)
+            S, D = to_object(ar, s, _take(origin, pos), _take(direction, pos))
+            sol = solve(ar, s, S, D, origin_term(ar, s, S), tmin, tmax)
+            st.tests += len(pos)
+            st.nan_tests += int(sol.bad.sum())
+            nan_pixel[pix[pos[sol.bad]]] = True
+            blocked[pos[sol.hit]] = True
+    st.skipped += n * (len(shapes) - 1) - (st.tests - before)
+    return blocked

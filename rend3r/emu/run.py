@@ -1,0 +1,69 @@
+"""Running a program: the processor drives the renderer at every ``nf``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+from ..errors import Rend3rError
+from .frame import Frame
+from .options import EmuOptions
+from .processor import execute
+from .scene import Scene
+from .stats import RunStats
+
+FrameHook = Callable[[Frame], None]
+#: Called during rendering with (frame number, fraction of that frame done).
+ProgressHook = Callable[[int, float], None]
+
+
+@dataclass
+class RunResult:
+    frames: list[Frame] = field(default_factory=list)
+    stats: RunStats = field(default_factory=RunStats)
+
+
+def _renderer(options: EmuOptions):
+    if options.mode == "raster":
+        try:
+            from .raster import render_frame  # provided by the rasterizer
+        except ImportError:
+            raise Rend3rError("--mode raster is not available yet: the rasterizer is not part of this build") from None
+        return render_frame
+    from .raytracer import render_frame
+
+    return render_frame
+
+
+def run_program(
+    words: Sequence[int],
+    options: EmuOptions | None = None,
+    frames: int | None = None,
+    on_frame: FrameHook | None = None,
+    progress: ProgressHook | None = None,
+    keep_frames: bool = True,
+) -> RunResult:
+    """Execute ``words``, rendering a frame at each ``nf`` (up to ``frames`` frames).
+
+    The program is first run without rendering, so decoding errors and unbounded loops are
+    reported before any time is spent on frames. ``keep_frames=False`` leaves
+    ``result.frames`` empty (use ``on_frame`` to consume frames as they come).
+    """
+    options = options or EmuOptions()
+    words = list(words)
+    execute(words, options, frames)  # validation pass
+    render = _renderer(options)
+    result = RunResult()
+
+    def on_nf(scene: Scene, number: int) -> None:
+        hook = (lambda f: progress(number, f)) if progress is not None else None
+        frame, st = render(scene, options, number, hook)
+        result.stats.frames.append(st)
+        if keep_frames:
+            result.frames.append(frame)
+        if on_frame is not None:
+            on_frame(frame)
+
+    ex = execute(words, options, frames, on_nf)
+    result.stats.instructions, result.stats.halt = ex.instructions, ex.halt
+    return result

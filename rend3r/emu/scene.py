@@ -1,0 +1,57 @@
+"""Scene state as the instruction processor leaves it: sparse, float16 bits as stored.
+
+Only what a program touched is held: a shape index near 2**19 costs one dict entry.
+Values are the raw 16-bit words of the instructions; the renderer interprets them with
+the property tables (never hard-coded numbers).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..isa import CameraSet, LightSet, ShapeSet, Table, ValueType, by_index, lookup
+
+
+def prop_index(table: Table, name: str) -> int:
+    """Index of a property by name (KeyError if the table has no such property)."""
+    prop = lookup(table, name)
+    if prop is None:
+        raise KeyError(f"{table.value} table has no property {name!r}")
+    return prop.index
+
+
+def _writes(table: Table, prop: int) -> bool:
+    """The null property (``zero``) writes nothing."""
+    p = by_index(table).get(prop)
+    return p is None or p.vtype is not ValueType.ZERO
+
+
+@dataclass
+class Scene:
+    """Camera, lights and shapes (or triangles): ``{index: {prop: bits}}``."""
+
+    camera: dict[int, int] = field(default_factory=dict)
+    lights: dict[int, dict[int, int]] = field(default_factory=dict)
+    objects: dict[int, dict[int, int]] = field(default_factory=dict)
+
+    def clear(self) -> None:
+        self.camera.clear()
+        self.lights.clear()
+        self.objects.clear()
+
+    def set_camera(self, ins: CameraSet) -> None:
+        if _writes(Table.CAMERA, ins.prop):
+            self.camera[ins.prop] = ins.data
+
+    def set_light(self, ins: LightSet) -> None:
+        if _writes(Table.LIGHT, ins.prop):
+            self.lights.setdefault(ins.index, {})[ins.prop] = ins.data
+
+    def set_object(self, ins: ShapeSet, table: Table) -> None:
+        """SE/SD: prop then prop2 (so prop2 wins when both name the same property)."""
+        for prop, data in ((ins.prop, ins.data), (ins.prop2, ins.data2)):
+            if _writes(table, prop):
+                self.objects.setdefault(ins.index, {})[prop] = data
+
+    def camera_bits(self, name: str, default: int = 0) -> int:
+        return self.camera.get(prop_index(Table.CAMERA, name), default)

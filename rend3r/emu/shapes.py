@@ -1,0 +1,152 @@
+"""Shapes in working precision and the raycaster, in the device's order of operations.
+
+Per shape: translate the ray origin by the negated location, rotate origin and direction
+by the inverse quaternion (conj(q) * (0, v) * q), multiply by the inverse scales, then the
+quadratic of the shape's normal form (sphere, cylinder, cone), solved as the device does.
+Everything is vectorised over (pixel, shape) pairs: arrays hold one entry per pair.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..isa import Table
+from .arith import Arith
+from .scene import Scene, prop_index
+from .vec import Quat, Vec, dot, madd3, mul3, rotate, rotate_inverse, sub3
+
+#: z-term sign and constant of each shape type's normal form: x^2 + y^2 + zsign*z^2 = one.
+NORMAL_FORMS = {1: (1.0, 1.0), 2: (0.0, 1.0), 3: (-1.0, 0.0)}  # sphere, cylinder, cone
+
+
+@dataclass(frozen=True)
+class Shapes:
+    """The shapes that are on, in index order (one entry per shape, or per pair after take)."""
+
+    index: np.ndarray  # program shape index (int64)
+    kind: np.ndarray  # 1 sphere, 2 cylinder, 3 cone
+    loc: Vec
+    rot: Quat
+    inv_scale: Vec
+    zsign: np.ndarray  # +1, 0, -1: how the z term enters the quadratic
+    one: np.ndarray  # 1 or 0: the constant of the normal form
+    color: np.ndarray  # RGB565, uint16
+
+    def __len__(self) -> int:
+        return len(self.index)
+
+    def take(self, sel: np.ndarray) -> "Shapes":
+        """The shapes at positions ``sel`` (e.g. one entry per pixel-shape pair)."""
+        t = lambda a: a[sel]  # noqa: E731
+        return Shapes(
+            t(self.index), t(self.kind), tuple(map(t, self.loc)), tuple(map(t, self.rot)),
+            tuple(map(t, self.inv_scale)), t(self.zsign), t(self.one), t(self.color),
+        )
+
+
+def shapes_from_scene(scene: Scene, arith: Arith) -> Shapes:
+    """Collect the shapes whose type is sphere, cylinder or cone (others are off)."""
+    p = {n: prop_index(Table.SHAPE, n) for n in (
+        "xloc", "yloc", "zloc", "rrot", "irot", "jrot", "krot", "xscl", "yscl", "zscl", "col", "type")}
+    rows = sorted((i, props) for i, props in scene.objects.items() if props.get(p["type"], 0) & 0xF in NORMAL_FORMS)
+    n = len(rows)
+
+    def bits(name: str) -> np.ndarray:
+        return np.fromiter((props.get(p[name], 0) for _, props in rows), dtype=np.uint16, count=n)
+
+    kind = bits("type") & 0xF
+    rot = [bits(n) for n in ("rrot", "irot", "jrot", "krot")]
+    unset = (rot[0] | rot[1] | rot[2] | rot[3]) & 0x7FFF == 0  # all-zero quaternion: identity
+    rot[0] = np.where(unset, np.uint16(0x3C00), rot[0])
+    forms = np.array([NORMAL_FORMS.get(int(k), (0.0, 0.0)) for k in range(16)])
+    return Shapes(
+        index=np.fromiter((i for i, _ in rows), dtype=np.int64, count=n),
+        kind=kind.astype(np.uint8),
+        loc=tuple(arith.from_bits(bits(a)) for a in ("xloc", "yloc", "zloc")),
+        rot=tuple(arith.from_bits(b) for b in rot),
+        inv_scale=tuple(arith.from_bits(bits(a)) for a in ("xscl", "yscl", "zscl")),
+        zsign=forms[kind, 0].astype(arith.dtype),
+        one=forms[kind, 1].astype(arith.dtype),
+        color=bits("col"),
+    )
+
+
+def to_object(ar: Arith, s: Shapes, point: Vec | None, direction: Vec | None) -> tuple[Vec | None, Vec | None]:
+    """A ray's origin and direction in each shape's normal space (either may be None)."""
+    S = mul3(ar, rotate_inverse(ar, s.rot, sub3(ar, point, s.loc)), s.inv_scale) if point is not None else None
+    D = mul3(ar, rotate_inverse(ar, s.rot, direction), s.inv_scale) if direction is not None else None
+    return S, D
+
+
+def _zterm(s: Shapes, p: np.ndarray) -> np.ndarray:
+    """The z product as the shape type uses it: kept, dropped (0) or negated."""
+    with np.errstate(invalid="ignore"):
+        return np.where(s.zsign == 0, np.zeros((), p.dtype), p * s.zsign)
+
+
+def origin_term(ar: Arith, s: Shapes, S: Vec) -> np.ndarray:
+    """c2 = 2*((Sx^2 + Sy^2) + (z term - one)): depends on the origin only."""
+    xy = ar.add(ar.mul(S[0], S[0]), ar.mul(S[1], S[1]))
+    h = ar.add(xy, ar.sub(_zterm(s, ar.mul(S[2], S[2])), s.one))
+    return ar.add(h, h)
+
+
+@dataclass(frozen=True)
+class Solution:
+    """Per pair: accepted hit, its t, whether any value was NaN or infinite, and the
+    solver's intermediate values (for tests and hardware comparison)."""
+
+    hit: np.ndarray
+    t: np.ndarray
+    bad: np.ndarray
+    a2: np.ndarray
+    b: np.ndarray
+    disc: np.ndarray
+    root: np.ndarray
+    t1: np.ndarray
+    t2: np.ndarray
+
+
+def _finite(*arrays: np.ndarray) -> np.ndarray:
+    ok = np.isfinite(arrays[0])
+    for a in arrays[1:]:
+        ok &= np.isfinite(a)
+    return ok
+
+
+def solve(ar: Arith, s: Shapes, S: Vec, D: Vec, c2: np.ndarray, tmin: np.ndarray, tmax: np.ndarray) -> Solution:
+    """The quadratic a2/2 t^2 + b t + c2/2 = 0, nearest root t >= tmin (and > 0), t <= tmax."""
+    dd = ar.add(ar.add(ar.mul(D[0], D[0]), ar.mul(D[1], D[1])), _zterm(s, ar.mul(D[2], D[2])))
+    ds = ar.add(ar.add(ar.mul(D[0], S[0]), ar.mul(D[1], S[1])), _zterm(s, ar.mul(D[2], S[2])))
+    a2 = ar.add(dd, dd)
+    b = ar.add(ds, ds)
+    disc = ar.sub(ar.mul(b, b), ar.mul(a2, c2))
+    real = disc >= 0
+    root = ar.sqrt(np.where(real, disc, np.zeros((), disc.dtype)))
+    nb = ar.neg(b)
+    t1 = ar.div(ar.sub(nb, root), a2)
+    t2 = ar.div(ar.add(nb, root), a2)
+    bad = ~_finite(a2, b, c2, disc) | (real & ~_finite(t1, t2))
+    ok1 = real & (t1 > 0) & (t1 >= tmin)
+    ok2 = real & (t2 > 0) & (t2 >= tmin)
+    t = np.where(ok1, t1, t2)
+    hit = (ok1 | ok2) & (t <= tmax) & ~bad
+    return Solution(hit, t, bad, a2, b, disc, root, t1, t2)
+
+
+def surface(ar: Arith, s: Shapes, S: Vec, D: Vec, t: np.ndarray, origin: Vec, direction: Vec) -> tuple[Vec, Vec]:
+    """World hit point origin + t*d, and world normal (object normal scaled, rotated by q)."""
+    point = madd3(ar, origin, t, direction)
+    P = madd3(ar, S, t, D)
+    normal_obj = (P[0], P[1], _zterm(s, P[2]))
+    normal = rotate(ar, s.rot, mul3(ar, normal_obj, s.inv_scale))
+    return point, normal
+
+
+def squared_distance(ar: Arith, dd_world: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """|d|^2 * t^2 in world space."""
+    return ar.mul(dd_world, ar.mul(t, t))
+
+

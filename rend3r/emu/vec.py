@@ -1,0 +1,66 @@
+"""Vector and quaternion operations in the device's order, on any :class:`Arith`.
+
+Vectors are 3-tuples and quaternions ``(r, i, j, k)`` 4-tuples of arrays (or 0-d arrays),
+so each component broadcasts over pixels and shapes independently.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .arith import Arith
+
+Vec = tuple[np.ndarray, np.ndarray, np.ndarray]
+Quat = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def dot(ar: Arith, a: Vec, b: Vec) -> np.ndarray:
+    """((x*x' + y*y') + z*z')."""
+    return ar.add(ar.add(ar.mul(a[0], b[0]), ar.mul(a[1], b[1])), ar.mul(a[2], b[2]))
+
+
+def sub3(ar: Arith, a: Vec, b: Vec) -> Vec:
+    return (ar.sub(a[0], b[0]), ar.sub(a[1], b[1]), ar.sub(a[2], b[2]))
+
+
+def mul3(ar: Arith, a: Vec, b: Vec) -> Vec:
+    """Componentwise product (scaling by per-axis factors)."""
+    return (ar.mul(a[0], b[0]), ar.mul(a[1], b[1]), ar.mul(a[2], b[2]))
+
+
+def madd3(ar: Arith, origin: Vec, t: np.ndarray, d: Vec) -> Vec:
+    """origin + t*d, each component one multiply then one add."""
+    return (ar.add(origin[0], ar.mul(t, d[0])), ar.add(origin[1], ar.mul(t, d[1])), ar.add(origin[2], ar.mul(t, d[2])))
+
+
+def hamilton(ar: Arith, a: Quat, b: Quat, real: bool = True) -> Quat:
+    """Hamilton product a*b with the device's pairwise sums.
+
+    ``real=False`` skips the real part (returned as None) when only the vector part is used.
+    """
+    m = ar.mul
+    r = ar.sub(ar.sub(m(a[0], b[0]), m(a[1], b[1])), ar.add(m(a[2], b[2]), m(a[3], b[3]))) if real else None
+    i = ar.add(ar.add(m(a[0], b[1]), m(a[1], b[0])), ar.sub(m(a[2], b[3]), m(a[3], b[2])))
+    j = ar.add(ar.sub(m(a[0], b[2]), m(a[1], b[3])), ar.add(m(a[2], b[0]), m(a[3], b[1])))
+    k = ar.sub(ar.add(m(a[0], b[3]), m(a[1], b[2])), ar.sub(m(a[2], b[1]), m(a[3], b[0])))
+    return (r, i, j, k)
+
+
+def conj(ar: Arith, q: Quat) -> Quat:
+    return (q[0], ar.neg(q[1]), ar.neg(q[2]), ar.neg(q[3]))
+
+
+def _pure(ar: Arith, v: Vec) -> Quat:
+    return (np.zeros((), dtype=ar.dtype), v[0], v[1], v[2])
+
+
+def rotate_inverse(ar: Arith, q: Quat, v: Vec) -> Vec:
+    """World to object: conj(q) * (0, v) * q (scaled by |q|^2 when q is not unit)."""
+    w = hamilton(ar, hamilton(ar, conj(ar, q), _pure(ar, v)), q, real=False)
+    return (w[1], w[2], w[3])
+
+
+def rotate(ar: Arith, q: Quat, v: Vec) -> Vec:
+    """Object to world: q * (0, v) * conj(q)."""
+    w = hamilton(ar, hamilton(ar, q, _pure(ar, v)), conj(ar, q), real=False)
+    return (w[1], w[2], w[3])

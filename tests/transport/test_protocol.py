@@ -42,6 +42,20 @@ def test_begin_and_commit_carry_length_and_program_crc():
     assert program_crc(words) == zlib.crc32(bytes.fromhex("00000200 3c000009 00000400" + "00" * 8))
 
 
+def test_the_worked_example_of_docs_protocol_md():
+    begin, data, commit = load_frames([0x200, 0x3C000009, 0x400, 0, 0], load=0x1234, first_seq=0x10)
+    hexes = [f.encode().hex(" ") for f in (begin, data, commit, data.reply(True))]
+    assert hexes == [
+        "01 01 12 34 00 10 00 00 00 00 00 00 00 08 00 00 00 00 00 05 d2 45 cc b7 59 c2 20 f6",
+        "01 02 12 34 00 11 00 05 00 00 00 00 00 14 00 00 00 00 02 00 3c 00 00 09 00 00 04 00"
+        " 00 00 00 00 00 00 00 00 b5 91 1b d4",
+        "01 03 12 34 00 12 00 00 00 00 00 00 00 08 00 00 00 00 00 05 d2 45 cc b7 c0 e0 f5 ee",
+        "01 80 12 34 00 11 00 05 00 00 00 00 00 00 02 00 5b 91 69 c1",
+    ]
+    assert (cobs.encode(begin.encode()) + b"\0").hex(" ") == (
+        "05 01 01 12 34 02 10 01 01 01 01 01 01 02 08 01 01 01 01 0a 05 d2 45 cc b7 59 c2 20 f6 00")
+
+
 def test_large_programs_split_into_256_word_frames():
     words = list(range(1000))
     frames_ = load_frames(words, load=1)

@@ -19,6 +19,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "device": ("rend3r.transport.cli:device_command", "Virtual device: receive programs over Ethernet or serial, render them to PNGs."),
     "send": ("rend3r.transport.cli:send_command", "Send a program to a device (Ethernet, serial) or a file (mem, coe, pcap)."),
     "disasm": ("rend3r.asm.cli_disasm:disasm_command", "Disassemble a memory image (mem, bin, coe, ihex, lst) to source."),
+    "trace-diff": ("rend3r.emu.trace_diff:trace_diff_command", "Compare two float16 pixel traces; report the first divergence."),
 }
 
 

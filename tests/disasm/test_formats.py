@@ -185,3 +185,30 @@ def test_explicit_format_overrides_detection(tmp_path):
     path.write_bytes(b"\x00\x00\x02\x00")
     assert read_file(path, "bin") == [0x200]
     assert read_file(path, "bin", "little") == [0x20000]
+
+
+@given(st.lists(st.integers(0, 2**32 - 1), min_size=1, max_size=50), st.sampled_from(["\n", "\r\n"]))
+def test_mem_plain_and_commented_files_read_alike(words, newline):
+    plain = "".join(f"{w:x}{newline}" for w in words)
+    commented = "// header\n" + plain.replace(newline, f" /* c */{newline}", 1)
+    assert read_words(plain.encode(), "mem") == words
+    assert read_words(plain.rstrip().encode(), "mem") == words
+    assert read_words(commented.encode(), "mem") == words
+
+
+def test_mem_reader_features():
+    text = b"// c\nDEAD_BEEF /* two\nlines */ 1\n@4 2 // jump\n@6\n3"
+    assert read_words(text, "mem") == [0xDEADBEEF, 1, 0, 0, 2, 0, 3]
+
+
+def test_coe_other_radixes_and_comments():
+    text = b"; c\n  ; indented comment\nMEMORY_INITIALIZATION_RADIX = 10 ;\nmemory_initialization_vector = 512 0,\n 4294967295;;\n"
+    assert read_words(text, "coe") == [512, 0, 2**32 - 1]
+    assert read_words(b"memory_initialization_radix=2;\nmemory_initialization_vector=1000000000,1;", "coe") == [512, 1]
+
+
+def test_ihex_segment_and_start_records_and_gaps():
+    # segment base 0x1000 (byte 0x10000 = word 0x4000) and a start-address record.
+    text = b":020000021000EC\n:0400000000000200FA\n:0400000500000000F7\n:00000001ff\n"
+    words = read_words(text, "ihex")
+    assert len(words) == 0x4001 and words[0x4000] == 0x200 and not any(words[:0x4000])

@@ -3,6 +3,7 @@ text decoding and word packing."""
 
 from __future__ import annotations
 
+import re
 import struct
 
 from ...errors import Rend3rError
@@ -14,7 +15,8 @@ MAX_WORDS = 1 << 24
 WORD_LIMIT = 1 << 32
 BYTEORDERS = ("big", "little")
 
-_CONTROL = {chr(c) for c in range(32)} - set("\t\n\r\f\v") | {"\x7f"}
+#: Control characters no text format contains (tab, newline, VT, FF and CR are allowed).
+_CONTROL = re.compile("[\x00-\x08\x0e-\x1f\x7f]")
 
 
 class TextInput:
@@ -48,10 +50,10 @@ def decode_text(data: bytes, name: str, fmt: str) -> str:
             f"{name}: not a text file (byte 0x{data[exc.start]:02x} at offset {exc.start} is not UTF-8); "
             f"expected {fmt} text (use --format bin for raw binary)"
         ) from None
-    bad = next((i for i, c in enumerate(text) if c in _CONTROL), None)
+    bad = _CONTROL.search(text)
     if bad is not None:
         raise Rend3rError(
-            f"{name}: not a text file (control character 0x{ord(text[bad]):02x} at character {bad}); "
+            f"{name}: not a text file (control character 0x{ord(bad.group()):02x} at character {bad.start()}); "
             f"expected {fmt} text (use --format bin for raw binary)"
         )
     return text.removeprefix("\ufeff")
@@ -63,7 +65,7 @@ def is_text(data: bytes) -> bool:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
         return False
-    return not any(c in _CONTROL for c in text)
+    return _CONTROL.search(text) is None
 
 
 def check_byteorder(byteorder: str) -> None:

@@ -48,6 +48,9 @@ def render_lst(program: Program) -> bytes:
 
 
 _HEX = re.compile(r"[0-9A-Fa-f]+")
+#: A well-formed row (the common case); anything else goes through the checks that
+#: find the position of the problem.
+_ROW = re.compile(r"[^|]*\|\s*([0-9A-Fa-f]+)\s*\|((?:\s*[0-9A-Fa-f]{1,8}(?![0-9A-Fa-f]))*\s*)(?:\||$)")
 
 
 def read_lst(data: bytes, name: str) -> list[int]:
@@ -57,6 +60,12 @@ def read_lst(data: bytes, name: str) -> list[int]:
     for pos, line in src.lines():
         stripped = line.strip()
         if not stripped or stripped.startswith(";"):
+            continue
+        m = _ROW.match(line)
+        if m and int(m.group(1), 16) == len(words):
+            words.extend(int(w, 16) for w in m.group(2).split())
+            if len(words) > MAX_WORDS:
+                raise src.error(pos, f"more than {MAX_WORDS} words")
             continue
         cells = line.split("|", 3)
         if len(cells) < 3:

@@ -58,6 +58,7 @@ def sd_positions(words: list[int]) -> set[int]:
     return sds
 
 
+_PLAIN = re.compile(r"(?:[0-9A-Fa-f]{1,8}\r?\n)*(?:[0-9A-Fa-f]{1,8}\r?\n?)?")
 _TOKEN = re.compile(
     r"""(?P<ws>\s+)
       | (?P<line>//[^\n]*)
@@ -77,7 +78,11 @@ def read_mem(data: bytes, name: str) -> list[int]:
     """
     src = TextInput(data, name, "mem")
     text = src.text
-    words: list[int] = []
+    if _PLAIN.fullmatch(text):  # plain words only, the usual case; problems go the long way
+        words = [int(w, 16) for w in text.split()]
+        if 0 < len(words) <= MAX_WORDS:
+            return words
+    words = []
     for m in _TOKEN.finditer(text):
         kind = m.lastgroup
         if kind == "word":

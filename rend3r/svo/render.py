@@ -23,13 +23,13 @@ class Render:
     rays: PrimaryRays
 
 
-def shade(result: TraceResult, rays: PrimaryRays, mode: str, height: int, width: int,
-          light=(0.4, 0.7, 0.6)) -> np.ndarray:
-    """``depth``: grey by eye distance (near bright); ``shaded``: Lambert on voxel faces."""
+def shade(result: TraceResult, direction: np.ndarray, dist: np.ndarray, mode: str, height: int,
+          width: int, light=(0.4, 0.7, 0.6)) -> np.ndarray:
+    """``depth``: grey by eye distance ``dist`` (near bright); ``shaded``: Lambert on the
+    entered voxel faces (``direction``: the rays' octree-space directions)."""
     hit = result.hit
     img = np.zeros((len(hit), 3), dtype=np.float64)
     if mode == "depth":
-        dist = t_to_distance(rays, result.t)
         if hit.any():
             lo, hi = dist[hit].min(), dist[hit].max()
             img[hit] = (1.0 - 0.8 * (dist[hit] - lo) / max(hi - lo, 1e-12))[:, None]
@@ -37,7 +37,7 @@ def shade(result: TraceResult, rays: PrimaryRays, mode: str, height: int, width:
         normal = np.zeros((len(hit), 3))
         rows = np.flatnonzero(hit)
         axis = result.axis[hit].astype(np.int64)
-        normal[rows, axis] = -np.sign(rays.direction[rows, axis])
+        normal[rows, axis] = -np.sign(direction[rows, axis])
         lvec = np.asarray(light, dtype=np.float64)
         lvec /= np.linalg.norm(lvec)
         lambert = np.clip(normal @ lvec, 0.0, 1.0)
@@ -59,10 +59,10 @@ def render(model: SvoModel, cam: Camera, stack_depth: int = 8, fixed: bool = Tru
     res.axis[beyond] = -1
     res.voxel[beyond] = -1
     h, w = cam.height, cam.width
-    rgb = shade(res, rays, mode, h, w)
+    dist = t_to_distance(rays, res.t)
+    rgb = shade(res, rays.direction, dist, mode, h, w)
     ndc = t_to_ndc_z(rays, res.t, cam).astype(np.float32).reshape(h, w)
-    dist = t_to_distance(rays, res.t).astype(np.float32).reshape(h, w)
-    return Render(rgb, ndc, dist, res.requests.reshape(h, w), res, rays)
+    return Render(rgb, ndc, dist.astype(np.float32).reshape(h, w), res.requests.reshape(h, w), res, rays)
 
 
 def cost_image(cost: np.ndarray) -> np.ndarray:

@@ -1,0 +1,186 @@
+"""``rend3r svo``: build octrees from meshes, render them, sweep hardware design points."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import click
+
+from ..errors import Rend3rError
+
+_EPILOG = """\b
+Examples:
+  rend3r svo model folded -o folded.ply
+  rend3r svo build folded.ply -o folded.svo --depth 10
+  rend3r svo render folded.svo -o folded.png --cost cost.png --stats
+  rend3r svo render folded.svo -o hybrid.png --with-program programs/sphere.asm --place 0.8,0.3,-3.5,0.8
+  rend3r svo sweep folded.svo -o sweep
+"""
+
+
+def _size(ctx, param, value: str) -> tuple[int, int]:
+    try:
+        w, h = (int(x) for x in value.lower().split("x"))
+    except ValueError:
+        raise click.BadParameter("expected WIDTHxHEIGHT, e.g. 640x480") from None
+    if not (0 < w <= 8192 and 0 < h <= 8192):
+        raise click.BadParameter("width and height must be 1..8192")
+    return w, h
+
+
+@click.group("svo", epilog=_EPILOG)
+def svo_group() -> None:
+    """Sparse voxel octrees after the SVO thesis: build, trace, simulate."""
+
+
+@svo_group.command("model")
+@click.argument("name", type=click.Choice(["sphere", "torus", "folded"]))
+@click.option("-o", "--output", required=True, help="Mesh file to write (.obj, .ply, .stl).")
+@click.option("--detail", type=click.IntRange(4, 2048), default=None, help="Tessellation (bands).")
+@click.option("--ascii", "ascii_", is_flag=True, help="ASCII PLY/STL instead of binary.")
+def model_cmd(name: str, output: str, detail: int | None, ascii_: bool) -> None:
+    """Write a procedural mesh NAME (no downloads)."""
+    from .mesh_io import write_mesh
+    from .models import make_model
+
+    verts, faces = make_model(name, detail)
+    write_mesh(output, verts, faces, binary=not ascii_)
+    click.echo(f"{output}: {len(verts)} vertices, {len(faces)} triangles")
+
+
+@svo_group.command("build")
+@click.argument("mesh", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", required=True, help=".svo file to write.")
+@click.option("--depth", type=click.IntRange(1, 16), default=None,
+              help="Octree levels (2**depth voxels per axis); binvox input: from its size.")
+@click.option("--solid", is_flag=True, help="Fill the inside of closed meshes.")
+@click.option("--ptr-bits", type=click.IntRange(4, 15), default=15, show_default=True,
+              help="Relative pointer width (smaller forces far pointers).")
+@click.option("--binvox", "binvox_out", default=None, help="Also write the voxels as binvox.")
+def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: int,
+              binvox_out: str | None) -> None:
+    """Voxelise MESH (.obj .ply .stl .binvox) and write the thesis's node format."""
+    import numpy as np
+
+    from .fileformat import SvoModel, write_svo
+    from .mesh_io import read_binvox, read_mesh, write_binvox
+    from .octree import build_octree
+    from .voxelize import voxelize
+
+    start = time.perf_counter()
+    if Path(mesh).suffix.lower() == ".binvox":
+        coords, dim, translate, scale = read_binvox(mesh)
+        need = max(int(np.ceil(np.log2(dim))), 1)
+        if depth is not None and depth != need:
+            raise Rend3rError(f"{mesh}: a {dim}^3 binvox grid needs --depth {need}")
+        depth = need
+        h = scale / dim
+        lo = np.asarray(translate, dtype=np.float64)
+        if solid:
+            raise Rend3rError("--solid applies to meshes; binvox voxels are used as stored")
+    else:
+        if depth is None:
+            raise Rend3rError("--depth is required for mesh input")
+        verts, faces = read_mesh(mesh)
+        coords, lo, h = voxelize(verts, faces, depth, solid)
+    tree = build_octree(coords, depth, ptr_bits)
+    hi = lo + h * (1 << depth)
+    write_svo(output, SvoModel(tree, tuple(float(x) for x in lo) + tuple(float(x) for x in hi), len(coords)))
+    if binvox_out:
+        write_binvox(binvox_out, coords, 1 << depth, tuple(lo), h * (1 << depth))
+    click.echo(f"{output}: depth {depth}, {len(coords)} voxels, {len(tree.words)} words "
+               f"({tree.far_count()} far pointers), {time.perf_counter() - start:.2f} s")
+
+
+def _place(value: str | None):
+    if value is None:
+        return None
+    try:
+        x, y, z, s = (float(v) for v in value.split(","))
+    except ValueError:
+        raise click.BadParameter("expected X,Y,Z,HALF_SIZE") from None
+    if not s > 0:
+        raise click.BadParameter("HALF_SIZE must be positive")
+    return (x - s, y - s, z - s, x + s, y + s, z + s)
+
+
+@svo_group.command("render")
+@click.argument("model", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", required=True, help="PNG image to write.")
+@click.option("--size", default="640x480", show_default=True, callback=_size, help="WIDTHxHEIGHT.")
+@click.option("--mode", type=click.Choice(["shaded", "depth"]), default="shaded", show_default=True)
+@click.option("--stack", type=click.IntRange(0, 64), default=8, show_default=True,
+              help="Short-stack depth (0 = restart only).")
+@click.option("--float", "use_float", is_flag=True, help="float64 reference instead of 16.16.")
+@click.option("--azimuth", type=float, default=35.0, show_default=True)
+@click.option("--elevation", type=float, default=25.0, show_default=True)
+@click.option("--distance", type=click.FloatRange(min=0.1), default=1.6, show_default=True,
+              help="Camera distance in half-diagonals of the model's cube.")
+@click.option("--cost", "cost_path", default=None, help="Also write the per-ray cost image.")
+@click.option("--stats", "show_stats", is_flag=True, help="Print traversal statistics as JSON.")
+@click.option("--with-program", "program", default=None, type=click.Path(dir_okay=False),
+              help="Merge into the frames of this REND3R program (its camera is used).")
+@click.option("--place", default=None, help="With --with-program: model centre and half size X,Y,Z,S.")
+def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: bool,
+               azimuth: float, elevation: float, distance: float, cost_path: str | None,
+               show_stats: bool, program: str | None, place: str | None) -> None:
+    """Trace MODEL.svo and write an image (depth or shaded)."""
+    from PIL import Image
+
+    from .camera import model_matrix, orbit_camera
+    from .fileformat import read_svo
+    from .render import cost_image, render
+
+    svo = read_svo(model)
+    if program is not None:
+        from .hybrid import program_hybrid, rgb565_to_888
+
+        bounds = _place(place) or svo.bounds
+        frames = program_hybrid(svo, program, model_matrix(bounds), size[0], size[1], stack)
+        if not frames:
+            raise Rend3rError(f"{program}: the program renders no frame")
+        Image.fromarray(rgb565_to_888(frames[0][0])).save(output)
+        click.echo(f"{output}: hybrid frame, {size[0]}x{size[1]}")
+        return
+    if place is not None:
+        raise Rend3rError("--place needs --with-program")
+    cam = orbit_camera(svo.bounds, azimuth, elevation, distance, size[0], size[1])
+    start = time.perf_counter()
+    r = render(svo, cam, stack, not use_float, mode)
+    elapsed = time.perf_counter() - start
+    Image.fromarray(r.rgb).save(output)
+    if cost_path:
+        Image.fromarray(cost_image(r.cost)).save(cost_path)
+    stats = r.result.stats()
+    stats["seconds"] = round(elapsed, 3)
+    stats["rays_per_s"] = round(stats["rays"] / max(elapsed, 1e-9))
+    if show_stats:
+        click.echo(json.dumps(stats, indent=2))
+    else:
+        click.echo(f"{output}: {stats['hits']}/{stats['rays']} hits, "
+                   f"{stats['requests_per_ray']:.2f} requests/ray, {elapsed:.2f} s")
+
+
+@svo_group.command("sweep")
+@click.argument("model", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", required=True, help="Output prefix: writes PREFIX.csv and PREFIX.md.")
+@click.option("--size", default="320x240", show_default=True, callback=_size, help="WIDTHxHEIGHT.")
+@click.option("--views", type=click.IntRange(1, 16), default=1, show_default=True,
+              help="Camera azimuths averaged (the thesis used four for Table 7.1).")
+@click.option("--jobs", type=click.IntRange(1, 64), default=2, show_default=True, help="Worker processes.")
+def sweep_cmd(model: str, output: str, size, views: int, jobs: int) -> None:
+    """Simulate the design points of the thesis's Tables 7.1 and 8.2 on MODEL.svo."""
+    from ..fileio import write_atomic
+    from .fileformat import read_svo
+    from .sweep import run_sweep, thesis_points, to_csv, to_markdown
+
+    svo = read_svo(model)
+    start = time.perf_counter()
+    rows = run_sweep(svo, thesis_points(), size[0], size[1], views, jobs)
+    write_atomic(output + ".csv", to_csv(rows).encode())
+    header = (f"# SVO design sweep: {Path(model).name}, {size[0]}x{size[1]}, {views} view(s)\n\n"
+              "Frame times from the model in rend3r/svo/cores.py (50 MHz, 95 MB/s).\n\n")
+    write_atomic(output + ".md", (header + to_markdown(rows)).encode())
+    click.echo(f"{output}.csv, {output}.md: {len(rows)} design points, {time.perf_counter() - start:.1f} s")

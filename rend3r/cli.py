@@ -16,10 +16,15 @@ from .errors import Rend3rError
 
 #: command name -> ("module:attribute", one-line help shown by ``rend3r --help``)
 COMMANDS: dict[str, tuple[str, str]] = {
+    "emulate": ("rend3r.emu.cli:emulate_command", "Run a program and render its frames to PNG, GIF or APNG (float16 golden model)."),
     "device": ("rend3r.transport.cli:device_command", "Virtual device: receive programs over Ethernet or serial, render them to PNGs."),
     "send": ("rend3r.transport.cli:send_command", "Send a program to a device (Ethernet, serial) or a file (mem, coe, pcap)."),
+    "compare": ("rend3r.golden.compare:compare_command", "Compare two images or RGB565 frame buffers by metrics."),
+    "asm": ("rend3r.asm.cli_asm:asm_command", "Assemble a .asm source to mem, bin, coe, ihex or a listing."),
     "disasm": ("rend3r.asm.cli_disasm:disasm_command", "Disassemble a memory image (mem, bin, coe, ihex, lst) to source."),
+    "render-all": ("rend3r.golden.render_all:render_all_command", "Render every example program to PNGs in a folder."),
     "trace-diff": ("rend3r.emu.trace_diff:trace_diff_command", "Compare two float16 pixel traces; report the first divergence."),
+    "svo": ("rend3r.svo.cli:svo_group", "Sparse voxel octrees: build from meshes, trace in 16.16 fixed point, sweep cache/core designs."),
 }
 
 

@@ -20,16 +20,37 @@ from .vec import Vec, dot, sub3
 
 #: Occlusion test: (light, positions of the lit points) -> mask of those in shadow.
 Occluder = Callable[[Light, np.ndarray, Vec], np.ndarray]
+#: Trace hook: (stage name, values per point) for every intermediate, in order.
+Recorder = Callable[[str, np.ndarray], None]
 _MAX = np.array([31, 63, 31])
+#: The device's intensity converter: I * 2**14 into a 13-bit signed integer.
+FIXED_SCALE, FIXED_BITS = 16384, 13
+
+
+def fixed_intensity(f: np.ndarray) -> np.ndarray:
+    """round(f * 16384) (nearest even) wrapped to a 13-bit two's-complement integer."""
+    k = np.rint(np.asarray(f, np.float64) * FIXED_SCALE).astype(np.int64)
+    half = 1 << (FIXED_BITS - 1)
+    return ((k + half) & ((1 << FIXED_BITS) - 1)) - half
 
 
 def diffuse(
-    ar: Arith, base: np.ndarray, normal: Vec, point: Vec, lights: list[Light], occluded: Occluder | None = None
+    ar: Arith,
+    base: np.ndarray,
+    normal: Vec,
+    point: Vec,
+    lights: list[Light],
+    occluded: Occluder | None = None,
+    intensity_fixed: bool = False,
+    record: Recorder | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """RGB565 per point and a mask of points whose lighting met NaN or infinity.
 
     ``occluded(light, lit, l_vec_of_lit)`` may veto lit points (shadow rays).
+    ``intensity_fixed``: the device's 13-bit conversion of ``f`` (quirk intensity-13bit).
+    ``record`` receives every intermediate (``docs/trace.md`` stage names).
     """
+    rec = record if record is not None else (lambda name, value: None)
     bad = ~(np.isfinite(point[0]) & np.isfinite(point[1]) & np.isfinite(point[2]))
     if not lights:
         return base, bad
@@ -37,19 +58,38 @@ def diffuse(
     acc = np.zeros_like(channels)
     nn = ar.sqrt(dot(ar, normal, normal))
     for light in lights:
+        tag = f"L{light.index}."
         if light.kind == POINT:
             l_vec = sub3(ar, light.location, point)
         else:
             l_vec = tuple(ar.neg(c) for c in light.forward)
-        cos = ar.div(dot(ar, normal, l_vec), ar.mul(nn, ar.sqrt(dot(ar, l_vec, l_vec))))
+        for axis, c in zip("xyz", l_vec):
+            rec(f"{tag}l.{axis}", c)
+        n_dot_l = dot(ar, normal, l_vec)
+        l_len = ar.sqrt(dot(ar, l_vec, l_vec))
+        denom = ar.mul(nn, l_len)
+        cos = ar.div(n_dot_l, denom)
         f = ar.mul(cos, light.intensity)
+        for name, value in (("n_dot_l", n_dot_l), ("n_len", nn), ("l_len", l_len), ("denom", denom),
+                            ("cos", cos), ("f", f)):
+            rec(tag + name, value)
         finite = np.isfinite(cos) & np.isfinite(f)
         bad |= ~finite
-        lit = np.nonzero(finite & ~bad & (cos > 0))[0]
+        factor = np.broadcast_to(np.asarray(f, np.float64), bad.shape)
+        if intensity_fixed:
+            k = fixed_intensity(np.where(finite, factor, 0.0))
+            rec(tag + "fixed", k)
+            factor = k / FIXED_SCALE
+        on = finite & ~bad & (cos > 0)
+        if intensity_fixed:
+            on &= factor > 0  # a wrapped, negative converter output is black
+        lit = np.nonzero(on)[0]
         if occluded is not None:
-            lit = lit[~occluded(light, lit, tuple(c[lit] if np.ndim(c) else c for c in l_vec))]
+            shadow = occluded(light, lit, tuple(c[lit] if np.ndim(c) else c for c in l_vec))
+            rec(tag + "shadow", shadow)
+            lit = lit[~shadow]
         lc = light.color
         scale = np.array([(lc >> 11) / 31.0, ((lc >> 5) & 0x3F) / 63.0, (lc & 0x1F) / 31.0])
-        acc[lit] += np.asarray(f, np.float64)[lit, None] * channels[lit] * scale
+        acc[lit] += factor[lit, None] * channels[lit] * scale
     ch = np.clip(np.floor(acc + 0.5), 0, _MAX).astype(np.uint16)
     return (ch[:, 0] << 11) | (ch[:, 1] << 5) | ch[:, 2], bad

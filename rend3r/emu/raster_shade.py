@@ -35,6 +35,11 @@ def centroids(ar: Arith, tris: np.ndarray) -> Vec:
     return tuple(ar.div(ar.add(ar.add(tris[:, 0, c], tris[:, 1, c]), tris[:, 2, c]), third) for c in range(3))
 
 
-def flat_colours(ar: Arith, tris: np.ndarray, base: np.ndarray, lights: list[Light]) -> tuple[np.ndarray, np.ndarray]:
+def flat_colours(
+    ar: Arith, tris: np.ndarray, base: np.ndarray, lights: list[Light], intensity_fixed: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
     """RGB565 per triangle, and a mask of triangles whose shading met NaN or infinity."""
-    return diffuse(ar, np.asarray(base, dtype=np.uint16), face_normals(ar, tris), centroids(ar, tris), lights)
+    return diffuse(
+        ar, np.asarray(base, dtype=np.uint16), face_normals(ar, tris), centroids(ar, tris), lights,
+        intensity_fixed=intensity_fixed,
+    )

@@ -16,13 +16,14 @@ import click
 
 from ..errors import Rend3rError
 
-Key = tuple[tuple[int, int], int | None, str, int]
+Key = tuple[int, tuple[int, int], int | None, str, int]
 
 
 @dataclass(frozen=True)
 class Record:
     """One traced value, with where it came from (file line)."""
 
+    frame: int
     pixel: tuple[int, int]
     shape: int | None
     stage: str
@@ -31,7 +32,7 @@ class Record:
     line: int
 
     def describe(self) -> str:
-        where = f"pixel ({self.pixel[0]},{self.pixel[1]})"
+        where = f"frame {self.frame} pixel ({self.pixel[0]},{self.pixel[1]})"
         if self.shape is not None:
             where += f" shape {self.shape}"
         return f"{where} stage {self.stage}"
@@ -63,13 +64,16 @@ def parse_record(text: str, where: str, line: int) -> Record:
     shape = obj.get("shape")
     if shape is not None and (not isinstance(shape, int) or isinstance(shape, bool)):
         raise Rend3rError(f"{where}: 'shape' must be an integer or null")
+    frame = obj.get("frame", 0)
+    if not isinstance(frame, int) or isinstance(frame, bool):
+        raise Rend3rError(f"{where}: 'frame' must be an integer")
     if not isinstance(obj["stage"], str):
         raise Rend3rError(f"{where}: 'stage' must be a string")
     try:
         bits = int(str(obj["hex"]), 16)
     except ValueError:
         raise Rend3rError(f"{where}: 'hex' {obj['hex']!r} is not hexadecimal") from None
-    return Record((px[0], px[1]), shape, obj["stage"], bits, _decimal(obj["dec"], where), line)
+    return Record(frame, (px[0], px[1]), shape, obj["stage"], bits, _decimal(obj["dec"], where), line)
 
 
 def read_trace(path: Path) -> list[Record]:
@@ -87,7 +91,7 @@ def _keyed(records: list[Record]) -> dict[Key, Record]:
     seen: dict[tuple, int] = {}
     out: dict[Key, Record] = {}
     for r in records:
-        base = (r.pixel, r.shape, r.stage)
+        base = (r.frame, r.pixel, r.shape, r.stage)
         k = seen.get(base, 0)
         seen[base] = k + 1
         out[(*base, k)] = r

@@ -36,7 +36,7 @@ def test_first_divergence_names_stage_pixel_shape(tmp_path):
     b = _write(tmp_path / "b.jsonl", changed)
     res = CliRunner().invoke(main, ["trace-diff", a, b])
     assert res.exit_code == 1
-    assert "pixel (252,188) shape 0 stage b" in res.output and "0xc400" in res.output and "0xc401" in res.output
+    assert "frame 0 pixel (252,188) shape 0 stage b" in res.output and "0xc400" in res.output and "0xc401" in res.output
 
 
 def test_decimal_mismatch_with_equal_bits_is_a_divergence(tmp_path):

@@ -15,6 +15,8 @@ D = 1.5556349                    ; R * sin 45
 
 nr
 cam rrot, 1
+cam hfov, 0.25          ; field of view: 0.25 of the default 10 x 7.5 viewport
+cam vfov, 0.25
 lt 0, src, 1
 lt 0, xfor, -0.5
 lt 0, yfor, -1

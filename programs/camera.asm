@@ -3,8 +3,9 @@
 ; Shows:  every camera property. A row of five spheres runs along -z from z = -4 to
 ;         z = -20 at x = 0. The camera stands at (3, 1.5, 0), turned 12 degrees to the
 ;         left (about +y) and tilted 5 degrees down (about x), with the field of view
-;         narrowed to 0.6 of the default in both axes; the near clip is 1 and the far clip
-;         13, so only the spheres nearer than 13 units are drawn.
+;         narrowed to 0.2 of the default in both axes; the near clip plane is 4.5 units
+;         ahead (it cuts into the nearest sphere) and the far clip 13, so the spheres
+;         beyond 13 units are not drawn.
 ; Run:    rend3r emulate programs/camera.asm -o camera.png
 ; Look:   three orange-to-yellow spheres shrinking into the distance from the lower left
 ;         towards the centre; the two farther spheres are cut away by the far clip plane.
@@ -19,10 +20,10 @@ cam rrot, 0.99357                ; q = rot(y, 12 deg) * rot(x, -5 deg)
 cam irot, -0.04338
 cam jrot, 0.10443
 cam krot, 0.00456
-cam nclip, 1
+cam nclip, 4.5
 cam fclip, 13
-cam hfov, 0.6
-cam vfov, 0.6
+cam hfov, 0.2
+cam vfov, 0.2
 
 lt 0, src, 1
 lt 0, xfor, -0.5

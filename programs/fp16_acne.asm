@@ -12,8 +12,8 @@
 
 nr
 cam rrot, 1
-cam hfov, 0.5
-cam vfov, 0.5
+cam hfov, 0.1
+cam vfov, 0.1
 
 lt 0, src, 1
 lt 0, xfor, -0.7

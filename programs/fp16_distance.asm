@@ -3,7 +3,9 @@
 ; Shows:  the squared hit distance |d|^2 * t^2 is a float16 and overflows (> 65504) once a
 ;         surface is more than about 256 units away; the ray then counts as a miss. Three
 ;         spheres of radius 50 whose centres are 220, 290 and 360 units from the camera
-;         (narrow field of view, 0.15 of the default).
+;         (narrow field of view, 0.15 of the default; the near clip at 100 makes the
+;         unnormalised ray directions 100 long, so nothing underflows, see
+;         fp16_underflow.asm).
 ; Run:    rend3r emulate programs/fp16_distance.asm -o fp16_distance.png
 ;         (compare --precision fp32, which draws all three)
 ; Look:   fp16: the left sphere whole; of the middle one only a central disc (the part
@@ -14,6 +16,7 @@ nr
 cam rrot, 1
 cam hfov, 0.15
 cam vfov, 0.15
+cam nclip, 100                  ; long ray directions: see fp16_underflow.asm
 
 lt 0, src, 1
 lt 0, xfor, -0.5

@@ -16,8 +16,8 @@
 
 nr
 cam rrot, 1
-cam hfov, 0.5
-cam vfov, 0.5
+cam hfov, 0.25
+cam vfov, 0.25
 lt 0, src, 1
 lt 0, xfor, -0.5
 lt 0, yfor, -1

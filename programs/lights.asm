@@ -12,6 +12,8 @@
 
 nr
 cam rrot, 1
+cam hfov, 0.25          ; field of view: 0.25 of the default 10 x 7.5 viewport
+cam vfov, 0.25
 
 lt 0, src, 1                    ; red, directional, travelling right
 lt 0, xfor, 1

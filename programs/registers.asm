@@ -15,6 +15,8 @@ NR
 cam a0, 0h1234                  ; zero property: any data, ignored
 cam a4, ONE                     ; rrot
 cam iro, 0                      ; the paper's spelling of irot
+cam a10, 0.25                   ; hfov
+cam A11, 0.25                   ; vfov (aliases are case-insensitive)
 
 lt 0, a0, 1                     ; src
 lt 0, a4, -1                    ; xfor

@@ -10,6 +10,8 @@
 
 nr
 cam rrot, 1                     ; identity camera rotation (the other parts stay 0)
+cam hfov, 0.25          ; field of view: 0.25 of the default 10 x 7.5 viewport
+cam vfov, 0.25
 
 lt 0, src, 1                    ; light 0: directional ...
 lt 0, xfor, -1                  ; ... travelling along (-1, -1, -1)

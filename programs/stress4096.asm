@@ -1,18 +1,24 @@
 ; stress4096.asm: 4,096 shapes.
 ;
-; Shows:  the paper's largest Table IV workload: a 64 x 64 grid of small spheres
-;         (radius 0.2, 0.5 apart in x, 0.375 in y) at z = -4, written with nested .rept;
-;         shape index = 64 * row + column. Red grows down the rows, blue across the
-;         columns. One directional light, so every hit also casts a shadow ray against
-;         4,095 other shapes.
+; Shows:  the paper's largest Table IV workload: 4,096 spheres (radius 0.45, 1 apart) in
+;         an 8 x 8 grid of columns 64 spheres deep, the front layer 5 units ahead,
+;         written with nested .rept; shape index = 64 * (8 * row + column) + depth.
+;         Red grows along x, green along y, blue fades with depth. One directional light, so
+;         every hit also casts a shadow ray against the 4,095 other shapes. The visible
+;         spheres are kept large compared with their distance: a wall of 64 x 64 tiny
+;         spheres would lose most of them to float16 cancellation in the quadratic (see
+;         docs/numerics.md and fp16_cancel.asm).
 ; Run:    rend3r emulate programs/stress4096.asm -o stress4096.png --stats
-; Look:   a lattice of small shaded beads filling most of the screen, black at the
-;         upper left, red at the bottom, blue at the right, magenta at the lower right.
+; Look:   an 8 x 8 block of shaded beads lit from the upper right, blue at the lower
+;         left, magenta to the right, cyan to the top; through the gaps between them
+;         the spheres behind recede in perspective.
 ; frames: 1
 ; test-size: 64x48
 
 nr
 cam rrot, 1
+cam hfov, 0.225         ; field of view: 0.225 of the default 10 x 7.5 viewport
+cam vfov, 0.225
 lt 0, src, 1
 lt 0, xfor, -0.3
 lt 0, yfor, -0.3
@@ -20,15 +26,15 @@ lt 0, zfor, -1
 lt 0, col, 0xFFFF
 lt 0, int, 1
 
-.rept 32, R
-.rept 2, h
-.rept 32, C
+.rept 8, J
+.rept 8, I
+.rept 32, K
 .rept 2, k
-sp 64 * (2 * R + h) + 2 * C + k, type, col, 1, 2048 * R + 1024 + C
-sp 64 * (2 * R + h) + 2 * C + k, xloc, yloc, (2 * C + k - 31.5) * 0.5, (31.5 - 2 * R - h) * 0.375
-sp 64 * (2 * R + h) + 2 * C + k, zloc, rrot, -4, 1
-sp 64 * (2 * R + h) + 2 * C + k, xscl, yscl, 5, 5
-sp 64 * (2 * R + h) + 2 * C + k, zscl, mat, 5, 0
+sp 64 * (8 * J + I) + 2 * K + k, type, col, 1, 8192 * I + 256 * J + 31 - K
+sp 64 * (8 * J + I) + 2 * K + k, xloc, yloc, I - 3.5, J - 3.5
+sp 64 * (8 * J + I) + 2 * K + k, zloc, rrot, -5 - 2 * K - k, 1
+sp 64 * (8 * J + I) + 2 * K + k, xscl, yscl, 1 / 0.45, 1 / 0.45
+sp 64 * (8 * J + I) + 2 * K + k, zscl, mat, 1 / 0.45, 0
 .endr
 .endr
 .endr

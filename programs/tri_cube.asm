@@ -7,18 +7,20 @@
 ;         every material value 0..3 (materials do not change the image) and set the zero
 ;         property.
 ; Run:    rend3r emulate programs/tri_cube.asm --mode raster -o tri_cube.png
-; Look:   three faces visible: blue (front, +z), green (top, +y), red (right, +x),
-;         flat-coloured (or shaded, depending on the rasterizer's lighting), with straight
-;         shared edges and no gaps between the two triangles of a face.
+; Look:   three faces visible: blue (front, +z), green (top, +y) and cyan (left, -x),
+;         each flat-shaded by the light from the upper left, with straight shared edges
+;         and no gap between the two triangles of a face.
 ; frames: 1
 ; mode: raster
 
 nr
 cam rrot, 1
+cam hfov, 0.25          ; field of view: 0.25 of the default 10 x 7.5 viewport
+cam vfov, 0.25
 lt 0, src, 1
-lt 0, xfor, -0.5
-lt 0, yfor, -1
-lt 0, zfor, -0.7
+lt 0, xfor, 0.3
+lt 0, yfor, -0.6
+lt 0, zfor, -1
 lt 0, col, 0xFFFF
 lt 0, int, 1
 

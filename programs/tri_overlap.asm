@@ -13,6 +13,8 @@
 
 nr
 cam rrot, 1
+cam hfov, 0.25          ; field of view: 0.25 of the default 10 x 7.5 viewport
+cam vfov, 0.25
 
 ; 0: red, near
 tr 0, x1, y1, -2, -1

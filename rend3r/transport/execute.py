@@ -7,12 +7,17 @@ starting a new program (or stopping) supersedes the running one at its next fram
 from __future__ import annotations
 
 import logging
+import os
 import re
 import threading
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING, Callable
 
 from ..errors import Rend3rError
+
+if TYPE_CHECKING:
+    from ..emu.frame import Frame
 
 log = logging.getLogger("rend3r.device")
 
@@ -25,11 +30,18 @@ def parse_size(text: str) -> tuple[int, int]:
     return int(m[1]), int(m[2])
 
 
-def render_frames(words: tuple[int, ...], width: int, height: int, max_frames: int):
-    """The frames the emulator renders for ``words`` (at most ``max_frames``)."""
+class _Superseded(Exception):
+    """Raised inside the emulator's frame callback to abandon a run that was replaced."""
+
+
+def run_and_save(words: tuple[int, ...], size: tuple[int, int], max_frames: int,
+                 save: Callable[[Frame], None]) -> None:
+    """Execute ``words`` in the emulator, handing each rendered frame to ``save``."""
     from ..emu import EmuOptions, run_program
 
-    return run_program(list(words), EmuOptions(width=width, height=height), frames=max_frames)
+    width, height = size
+    run_program(list(words), EmuOptions(width=width, height=height), frames=max_frames,
+                on_frame=save, keep_frames=False)
 
 
 class RenderExecutor:
@@ -76,13 +88,24 @@ class RenderExecutor:
     def _run(self, words: tuple[int, ...], run: int, cancel: threading.Event) -> None:
         from ..emu.image import save_png
 
+        def save(frame: Frame) -> None:
+            delay = self._next_frame_at - time.monotonic()
+            if cancel.wait(max(0.0, delay)):
+                raise _Superseded
+            name = f"run{run:04d}_frame{frame.number:04d}.png"
+            tmp = self.out / f".{name}.tmp"  # renamed when complete: readers never see half a PNG
+            save_png(frame.rgb565, tmp)
+            os.replace(tmp, self.out / name)
+            self._next_frame_at = time.monotonic() + self.interval
+            self.frames += 1
+
+        if not words:
+            return  # the all-zero memory: nothing to execute
         try:
-            for frame in render_frames(words, *self.size, self.max_frames):
-                delay = self._next_frame_at - time.monotonic()
-                if cancel.wait(max(0.0, delay)):
-                    return
-                save_png(frame, self.out / f"run{run:04d}_frame{frame.number:04d}.png")
-                self._next_frame_at = time.monotonic() + self.interval
-                self.frames += 1
+            run_and_save(words, self.size, self.max_frames, save)
+        except _Superseded:
+            pass
         except Rend3rError as exc:
             log.warning("program of run %d stopped: %s", run, exc)
+        except Exception:  # an emulator bug must not take the device down
+            log.exception("program of run %d crashed the emulator", run)

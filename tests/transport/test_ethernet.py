@@ -118,3 +118,29 @@ def test_raw_pcap_is_bare_words(tmp_path):
     packets = rdpcap(str(out))
     assert [p[Ether].type for p in packets] == [0x88B6, 0x88B6]
     assert b"".join(bytes(p[Ether].payload) for p in packets) == words_to_bytes(words)
+
+
+@needs_netns
+@pytest.mark.timeout(180)
+def test_send_and_device_commands_over_veth(tmp_path):
+    """Both commands, each in its own process, inside one private namespace."""
+    prog = Path(__file__).resolve().parents[2] / "programs" / "sphere.asm"
+    out, log = tmp_path / "frames", tmp_path / "device.log"
+    rend3r = " ".join(RENDER)
+    script = f"""
+        set -e
+        ip link add v0 type veth peer name v1; ip link set v0 up; ip link set v1 up
+        {rend3r} device --eth v1 -o {out} --size 32x24 --frames 1 2>{log} & pid=$!
+        until grep -q listening {log}; do sleep 0.05; done
+        {rend3r} send {prog} --eth v0 --run
+        {rend3r} send {prog} --eth v0 --mac 02:00:00:00:00:42 --timeout 0.05 --retries 1 || echo refused
+        for i in $(seq 600); do ls {out}/*.png >/dev/null 2>&1 && break; sleep 0.1; done
+        kill -TERM $pid; wait $pid
+    """
+    r = in_netns(script, timeout=170)
+    device_log = log.read_text()
+    assert r.returncode == 0, r.stderr + device_log
+    assert "loaded" in r.stderr and "refused" in r.stdout
+    assert "no acknowledgement for BEGIN after 2 tries" in r.stderr
+    assert "stopped after 1 loads" in device_log and "frames for other addresses" in device_log
+    assert list(out.glob("*.png"))

@@ -362,7 +362,7 @@ class Assembler:
             return
         if m == "cam":
             prop = self.prop(table, ops[0])
-            data = self.data(prop, ops[1]) if prop else None
+            data = self.data(prop, ops[1])
             if data is not None:
                 self.emit(m, encode(CameraSet(prop.index, data)), loc, text)
             return
@@ -372,13 +372,13 @@ class Assembler:
             self.target_index(m, table, index, ops[0])
         if m == "lt":
             prop = self.prop(table, ops[1])
-            data = self.data(prop, ops[2]) if prop else None
+            data = self.data(prop, ops[2])
             if index is not None and data is not None:
                 self.emit(m, encode(LightSet(index, prop.index, data)), loc, text)
             return
         prop, prop2 = self.prop(table, ops[1]), self.prop(table, ops[2])
-        data = self.data(prop, ops[3]) if prop else None
-        data2 = self.data(prop2, ops[4]) if prop2 else None
+        data = self.data(prop, ops[3])
+        data2 = self.data(prop2, ops[4])
         if prop and prop2 and prop.index == prop2.index and prop.vtype is not ValueType.ZERO:
             self.warning(
                 f"prop and prop2 are both '{prop.name}': the device writes both and the second value wins",
@@ -415,10 +415,11 @@ class Assembler:
         self.error(f"unknown {table.value} property '{node.name}'{hint}", node.col, node.end)
         return None
 
-    def data(self, prop: Property, node: Operand) -> int | None:
-        """The 16 data bits for ``prop`` from ``node``, or None after reporting why not."""
+    def data(self, prop: Property | None, node: Operand) -> int | None:
+        """The 16 data bits for ``prop`` from ``node``, or None after reporting why not
+        (with no property, only the expression itself is checked)."""
         v = self.evaluate(node)
-        if v is None:
+        if v is None or prop is None:
             return None
         if v.raw is not None:
             return v.raw

@@ -1,0 +1,50 @@
+// Every shape property by name and alias, as prop and as prop2; index extremes.
+// SE: index[18:3] 31:16, prop 15:11, prop2 10:6, index[2:0] 5:3, opcode 101; SD: data 31:16, data2 15:0.
+sp 0, zero, xloc, 0, 0.25           ; => 0x00000045 0x00003400
+sp 524287, zero, a1, 0, 100         ; => 0xffff007d 0x00005640
+sp 5, a0, a1, 0, -0.125             ; => 0x0000006d 0x0000b000
+sp 8, xloc, yloc, -0.125, 3         ; => 0x00010885 0xb0004200
+sp 0, xloc, a2, 3, 1.5              ; => 0x00000885 0x42003e00
+sp 524287, a1, a2, 1.5, -2          ; => 0xffff08bd 0x3e00c000
+sp 5, yloc, zloc, -2, 0.25          ; => 0x000010ed 0xc0003400
+sp 8, yloc, a3, 0.25, 100           ; => 0x000110c5 0x34005640
+sp 0, a2, a3, 100, -0.125           ; => 0x000010c5 0x5640b000
+sp 524287, zloc, rrot, -0.125, 3    ; => 0xffff193d 0xb0004200
+sp 5, zloc, a4, 3, 1.5              ; => 0x0000192d 0x42003e00
+sp 8, a3, a4, 1.5, -2               ; => 0x00011905 0x3e00c000
+sp 0, rrot, irot, -2, 0.25          ; => 0x00002145 0xc0003400
+sp 524287, rrot, a5, 0.25, 100      ; => 0xffff217d 0x34005640
+sp 5, a4, a5, 100, -0.125           ; => 0x0000216d 0x5640b000
+sp 8, irot, jrot, -0.125, 3         ; => 0x00012985 0xb0004200
+sp 0, irot, a6, 3, 1.5              ; => 0x00002985 0x42003e00
+sp 524287, a5, a6, 1.5, -2          ; => 0xffff29bd 0x3e00c000
+sp 5, iro, a6, -2, 0.25             ; => 0x000029ad 0xc0003400
+sp 8, jrot, krot, 0.25, 100         ; => 0x000131c5 0x34005640
+sp 0, jrot, a7, 100, -0.125         ; => 0x000031c5 0x5640b000
+sp 524287, a6, a7, -0.125, 3        ; => 0xffff31fd 0xb0004200
+sp 5, krot, xscl, 3, 1.5            ; => 0x00003a2d 0x42003e00
+sp 8, krot, a8, 1.5, -2             ; => 0x00013a05 0x3e00c000
+sp 0, a7, a8, -2, 0.25              ; => 0x00003a05 0xc0003400
+sp 524287, xscl, yscl, 0.25, 100    ; => 0xffff427d 0x34005640
+sp 5, xscl, a9, 100, -0.125         ; => 0x0000426d 0x5640b000
+sp 8, a8, a9, -0.125, 3             ; => 0x00014245 0xb0004200
+sp 0, yscl, zscl, 3, 1.5            ; => 0x00004a85 0x42003e00
+sp 524287, yscl, a10, 1.5, -2       ; => 0xffff4abd 0x3e00c000
+sp 5, a9, a10, -2, 0.25             ; => 0x00004aad 0xc0003400
+sp 8, zscl, col, 0.25, 65534        ; => 0x000152c5 0x3400fffe
+sp 0, zscl, a11, 100, 65535         ; => 0x000052c5 0x5640ffff
+sp 524287, a10, a11, -0.125, 65534  ; => 0xffff52fd 0xb000fffe
+sp 5, col, mat, 65534, 3            ; => 0x00005b2d 0xfffe0003
+sp 8, col, a12, 65535, 2            ; => 0x00015b05 0xffff0002
+sp 0, a11, a12, 65534, 3            ; => 0x00005b05 0xfffe0003
+sp 524287, mat, type, 3, 14         ; => 0xffff637d 0x0003000e
+sp 5, mat, a13, 2, 15               ; => 0x0000636d 0x0002000f
+sp 8, a12, a13, 3, 14               ; => 0x00016345 0x0003000e
+sp 0, type, zero, 14, 0             ; => 0x00006805 0x000e0000
+sp 524287, type, a0, 15, 0          ; => 0xffff683d 0x000f0000
+sp 5, a13, a0, 14, 0                ; => 0x0000682d 0x000e0000
+sp 524287, type, col, 0h0001, 0b11111_000000_00000 ; => 0xffff6afd 0x0001f800
+sp 524288, xloc, yloc, 1, 1         ; error: shape index 524288 is out of range (0..524287)
+sp 0, x1, xloc, 1, 1                ; error: unknown shape property 'x1'
+er                                  ; => 0x00000000
+er                                  ; => 0x00000000

@@ -1,0 +1,90 @@
+"""``rend3r asm``: assemble a source file into one or more memory-image formats."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from ..errors import Rend3rError
+from ..isa.targets import TARGETS
+from .formats import FORMATS, render
+
+
+def output_paths(src: Path, out: str | None, formats: list[str], extensions: dict[str, str]) -> dict[str, str | None]:
+    """Where each format goes; None means standard output.
+
+    One format: ``-o OUT`` is the exact path (``-`` or no ``-o``: standard output).
+    Several formats: ``-o`` is a stem (a trailing format extension is dropped; default:
+    the source path without ``.asm``) and each format adds its own extension.
+    """
+    if len(formats) == 1:
+        return {formats[0]: None if out in (None, "-") else out}
+    if out == "-":
+        raise Rend3rError("-o - (standard output) takes a single format")
+    stem = out if out is not None else str(src.with_suffix("")) if src.suffix.lower() == ".asm" else str(src)
+    for ext in sorted(extensions.values(), key=len, reverse=True):
+        if stem.endswith(ext):
+            stem = stem[: -len(ext)]
+            break
+    paths = {fmt: stem + extensions[fmt] for fmt in formats}
+    if len(set(paths.values())) != len(paths):
+        raise Rend3rError("two formats would be written to the same file; give fewer formats")
+    return paths
+
+
+@click.command(
+    "asm",
+    epilog="""\b
+Examples:
+  rend3r asm scene.asm                    print the mem image on standard output
+  rend3r asm scene.asm -o main.mem        write main.mem ($readmemh, one word per line)
+  rend3r asm scene.asm -f mem -f lst -o build/scene
+                                          write build/scene.mem and build/scene.lst
+  rend3r asm scene.asm -f bin -o scene.bin --byteorder little
+  rend3r asm scene.asm --target rend3r-main -W error -I lib/
+""",
+)
+@click.argument("src", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("-o", "--output", "out", metavar="OUT",
+              help="Output file (one format; '-' = stdout) or stem (several formats).")
+@click.option("-f", "--format", "formats", multiple=True, type=click.Choice(list(FORMATS)),
+              help="Output format; repeat for several (default: mem).")
+@click.option("-I", "--include-dir", "include_dirs", multiple=True, metavar="DIR",
+              help="Directory searched by .include after the including file's own directory; repeatable.")
+@click.option("--target", type=click.Choice(sorted(TARGETS)),
+              help="Warn about indices and program sizes beyond this device build's memories.")
+@click.option("--byteorder", type=click.Choice(["big", "little"]), default="big", show_default=True,
+              help="Byte order of each word in bin and ihex output.")
+@click.option("-W", "warn", type=click.Choice(["error"]), help="-W error: treat warnings as errors.")
+@click.option("--werror", is_flag=True, help="Treat warnings as errors (same as -W error).")
+def asm_command(src: Path, out: str | None, formats: tuple[str, ...], include_dirs: tuple[str, ...],
+                target: str | None, byteorder: str, warn: str | None, werror: bool) -> None:
+    """Assemble SRC (a .asm file) into memory images for the REND3R device.
+
+    Diagnostics go to standard error. On any error the exit status is 1 and no output
+    file is created or changed; files are written atomically once everything succeeded.
+    """
+    from ..fileio import write_atomic
+    from .assembler import assemble_file
+
+    fmts = list(dict.fromkeys(formats or ("mem",)))
+    extensions = {name: FORMATS[name].extension for name in fmts}
+    paths = output_paths(src, out, fmts, extensions)
+    for fmt, path in paths.items():
+        if path is None and FORMATS[fmt].binary and sys.stdout.isatty():
+            raise Rend3rError(f"{fmt} output is binary: give -o FILE (or redirect standard output)")
+    result = assemble_file(src, include_dirs, target, werror=werror or warn == "error")
+    if result.diagnostics:
+        click.echo(result.format_diagnostics(), err=True)
+    if not result.ok:
+        raise Rend3rError(f"{src}: {len(result.errors)} error(s); no output written")
+    rendered = {fmt: render(fmt, result.program, byteorder=byteorder) for fmt in fmts}
+    for fmt, path in paths.items():
+        if path is None:
+            stream = click.get_binary_stream("stdout")
+            stream.write(rendered[fmt])
+            stream.flush()
+        else:
+            write_atomic(path, rendered[fmt])

@@ -50,6 +50,7 @@ def test_thousand_programs_through_loss_and_corruption():
     assert core.counters.loads == 1000
     # the fault model really was exercised, in both directions
     assert link.injected["loss"] > 500 and link.injected["corrupt"] > 250
+    assert link.injected["duplicate"] > 50 and link.injected["reorder"] > 50
     assert core.counters.malformed > 100 and sender.stats.ignored > 50
     assert sender.stats.resends > 500
 

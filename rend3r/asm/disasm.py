@@ -8,8 +8,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..isa.encoding import is_canonical
-from ..isa.float16 import shortest_repr
+from ..isa.float16 import bits_to_float, round_literal, shortest_repr
 from ..isa.tables import (
     DATA,
     F_MNEMONICS,
@@ -37,6 +39,9 @@ MODES: dict[str, tuple[str, Table]] = {"raytrace": ("sp", Table.SHAPE), "raster"
 
 _F_NAMES = {func: name for name, func in F_MNEMONICS.items()}
 _COMMENT_COLUMN = 40
+#: The assembler warns when a float literal loses more than this share of its value
+#: (syntax.md); disassembled floats stay within it.
+LOSS_WARNING = 0.01
 
 
 @dataclass(frozen=True)
@@ -54,13 +59,34 @@ def format_value(prop: Property, bits: int) -> str:
     if prop.vtype is ValueType.ZERO:
         return "0" if bits == 0 else f"0h{bits:04x}"
     if prop.vtype is ValueType.FLOAT16:
-        text = shortest_repr(bits)
-        return text if text is not None else f"0h{bits:04x}"
+        return float_operand(bits)
     if bits >> prop.bits:
         return f"0h{bits:04x}"
     if prop.name == "col":
         return f"0b{bits >> 11:05b}_{(bits >> 5) & 0x3F:06b}_{bits & 0x1F:05b}"
     return str(bits)
+
+
+def float_operand(bits: int) -> str:
+    """The shortest decimal that rounds back to ``bits`` without the assembler's
+    precision warning; ``0hXXXX`` for NaN and infinities.
+
+    For most values that is ``shortest_repr``. For small subnormals the shortest
+    round-tripping decimal can be far from the value (``1.0e-07`` for 0x0002, which is
+    1.19e-07, 19% off), so more digits are used until it is within the warning threshold.
+    """
+    text = shortest_repr(bits)
+    if text is None:
+        return f"0h{bits:04x}"
+    digits = 1
+    while _loss(text) > LOSS_WARNING:
+        digits += 1
+        text = np.format_float_scientific(bits_to_float(bits), precision=digits, unique=False, trim="0").replace("e+", "e")
+    return text
+
+
+def _loss(text: str) -> float:
+    return round_literal(text.lstrip("-"), negative=text.startswith("-")).relative_error
 
 
 def _word(address: int, word: int, note: str) -> Line:

@@ -5,9 +5,10 @@ from __future__ import annotations
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from rend3r.asm.disasm import disassemble, disassemble_lines, disassemble_program, format_value
+from rend3r.asm.disasm import LOSS_WARNING, disassemble, disassemble_lines, disassemble_program, float_operand, format_value
 from rend3r.asm.formats import FORMATS, read_words, render
-from rend3r.isa import CameraSet, FrameOp, Func, LightSet, ShapeSet, Table, encode, lookup
+from rend3r.isa import CameraSet, LightSet, ShapeSet, Table, encode, lookup
+from rend3r.isa.float16 import round_literal, shortest_repr
 
 from .strategies import word_streams
 
@@ -140,3 +141,27 @@ def test_disassembled_program_renders_in_every_format(words, fmt):
         rows = data.decode().splitlines()[2:]
         sources = [row.split("|", 3)[3].strip() for row in rows if row.split("|", 3)[3].strip()]
         assert sources == [e.text for e in program.entries]
+
+
+#: Every subnormal of both signs (the only values where the shortest decimal can be more
+#: than 1% off: for normals it is within half an ulp, under 0.05%), plus a spread of the rest.
+SUBNORMALS = [*range(0x0000, 0x0400), *range(0x8000, 0x8400)]
+SAMPLED_BITS = sorted(set(SUBNORMALS) | set(range(0x0400, 0x10000, 37)))
+
+
+def test_float16_operands_round_back_without_a_precision_warning():
+    longer = 0
+    for bits in SAMPLED_BITS:
+        text = float_operand(bits)
+        if text.startswith("0h"):
+            assert shortest_repr(bits) is None
+            continue
+        rounded = round_literal(text.lstrip("-"), negative=text.startswith("-"))
+        assert rounded.bits == bits and rounded.relative_error <= LOSS_WARNING, (hex(bits), text)
+        longer += text != shortest_repr(bits)
+    assert longer == 24  # 12 small subnormals, each sign: 0x0002 is 1.19e-07, not 1.0e-07
+
+
+def test_small_subnormal_keeps_enough_digits():
+    assert float_operand(0x0002) == "1.19e-07"
+    assert float_operand(0x8001) == "-6.0e-08"

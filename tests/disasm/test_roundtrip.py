@@ -8,6 +8,7 @@ from hypothesis import given, settings, strategies as st
 
 from rend3r.asm.disasm import disassemble
 from rend3r.asm.formats import FORMATS, read_words, render
+from rend3r.isa import CameraSet, LightSet, encode
 from rend3r.isa.tables import LIGHT_INDEX_LIMIT, MNEMONIC_TABLE, PROPERTIES, SHAPE_INDEX_LIMIT, Table, ValueType
 
 from .strategies import instructions, word_streams
@@ -42,6 +43,17 @@ def test_well_formed_instructions_print_as_instructions(mode_and_words):
     text = disassemble(list(words), mode)
     assert ".word" not in text
     assert assemble(text) == list(words)
+
+
+def test_field_values_assemble_back_without_diagnostics():
+    """Every subnormal and a spread of other float16 values, and a spread of colours,
+    printed canonically, assemble to the same words with no warning at all."""
+    floats = [*range(0x0000, 0x0400), *range(0x8000, 0x8400), *range(0x0400, 0x10000, 37)]
+    words = [encode(CameraSet(1, b))[0] for b in floats]
+    words += [encode(LightSet(b % 64, 7, b))[0] for b in range(0, 0x10000, 29)] + [0, 0]
+    result = assembler.assemble_source(disassemble(words))
+    assert result.ok and result.diagnostics == [], result.format_diagnostics()[:2000]
+    assert result.program.words == words
 
 
 def _table(mode: str) -> Table:

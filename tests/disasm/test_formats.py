@@ -212,3 +212,11 @@ def test_ihex_segment_and_start_records_and_gaps():
     text = b":020000021000EC\n:0400000000000200FA\n:0400000500000000F7\n:00000001ff\n"
     words = read_words(text, "ihex")
     assert len(words) == 0x4001 and words[0x4000] == 0x200 and not any(words[:0x4000])
+
+
+@pytest.mark.parametrize("fmt", ["mem", "coe", "ihex", "lst"])
+def test_utf8_bom_and_crlf_are_accepted(fmt):
+    text = render(fmt, SAMPLE).decode().replace("\n", "\r\n")
+    data = "\ufeff".encode() + text.encode()
+    assert detect_format(data) == fmt
+    assert read_words(data) == SAMPLE.words

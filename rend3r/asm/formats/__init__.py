@@ -101,7 +101,7 @@ def detect_format(data: bytes, name: str | None = None) -> str:
             return _EXTENSIONS[suffix]
     if not is_text(data):
         return "bin"
-    text = data.decode("utf-8")
+    text = data.decode("utf-8").removeprefix("\ufeff")
     first = next((line.strip() for line in text.splitlines() if line.strip()), "")
     if first.startswith(":"):
         return "ihex"

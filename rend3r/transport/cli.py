@@ -18,7 +18,7 @@ from .links import (
     DEFAULT_ETHERTYPE, DEFAULT_MAC, ETH_MAX_PAYLOAD, EthernetLink, Link, SerialLink,
     ethernet_frame, format_mac, open_serial, parse_mac,
 )
-from .protocol import FrameError, FrameType, program_crc, words_to_bytes
+from .protocol import Frame, FrameError, FrameType, program_crc, words_to_bytes
 from .session import DEFAULT_RETRIES, DEFAULT_TIMEOUT, Sender, load_frames
 
 #: Source MAC written into --pcap frames (locally administered, never on a real wire).
@@ -119,18 +119,23 @@ def send_command(program: str, mem_out: str | None, coe_out: str | None, iface: 
     link: Link = (EthernetLink(iface, peer=device_mac, ethertype=etype) if iface
                   else SerialLink(open_serial(port, baud)))
     where = f"{iface} -> {format_mac(device_mac)}" if iface else port
+    from serial import SerialException
+
     with link:
         start = time.monotonic()
-        if framing == "raw":
-            _send_raw(link, words)
-            say(f"sent {len(words)} raw words to {where} (no acknowledgement in raw framing)")
-            return
-        sender = Sender(link, timeout=timeout, retries=retries,
-                        progress=_Progress(not quiet and len(words) >= 4096))
-        sender.load(words)
-        if run_after:
-            sender.control(FrameType.RUN)
-        status = sender.status()
+        try:
+            if framing == "raw":
+                _send_raw(link, words)
+                say(f"sent {len(words)} raw words to {where} (no acknowledgement in raw framing)")
+                return
+            sender = Sender(link, timeout=timeout, retries=retries,
+                            progress=_Progress(not quiet and len(words) >= 4096))
+            sender.load(words)
+            if run_after:
+                sender.control(FrameType.RUN)
+            status = sender.status()
+        except (OSError, SerialException) as exc:
+            raise Rend3rError(f"{where}: the link failed: {getattr(exc, 'strerror', None) or exc}") from exc
         elapsed = time.monotonic() - start
     if (status.words, status.crc) != (len(words), crc):
         raise Rend3rError(f"the device reports {status.words} words with CRC-32 {status.crc:08x} "
@@ -166,8 +171,6 @@ def _write_pcap(path: str, words: list[int], mac: bytes, etype: int, framing: st
         rng = random.Random()
         frames = load_frames(words, rng.randrange(1, 1 << 16), rng.randrange(1 << 16))
         if run:
-            from .protocol import Frame
-
             frames.append(Frame(FrameType.RUN, 0, (frames[-1].seq + 1) & 0xFFFF))
         payloads = [f.encode() for f in frames]
     buf = io.BytesIO()
@@ -183,17 +186,24 @@ def _write_pcap(path: str, words: list[int], mac: bytes, etype: int, framing: st
 
 def serve(link: Link, core, stop: threading.Event, poll: float = 0.1) -> None:
     """Answer frames arriving on ``link`` with ``core`` until ``stop`` is set."""
+    from serial import SerialException
+
     while not stop.is_set():
         try:
             data = link.recv(poll)
         except FrameError as exc:
             core.malformed(str(exc))
             continue
+        except (OSError, SerialException) as exc:
+            raise Rend3rError(f"the link failed while receiving: {exc}") from exc
         if data is None:
             continue
         reply = core.handle(data)
         if reply is not None:
-            link.send(reply)
+            try:
+                link.send(reply)
+            except (OSError, SerialException) as exc:  # the sender resends; keep serving
+                logging.getLogger("rend3r.device").warning("could not send a reply: %s", exc)
 
 
 @click.command("device")

@@ -122,7 +122,9 @@ class SerialLink(Link):
             remaining = deadline - time.monotonic()
             if remaining <= 0:
                 return None
-            self.port.timeout = min(remaining, self.POLL)
+            wait = min(remaining, self.POLL)
+            if self.port.timeout != wait:  # reconfiguring a port costs system calls
+                self.port.timeout = wait
             chunk = self.port.read(max(1, self.port.in_waiting))
             self.rx_bytes += len(chunk)
             self._buf += chunk

@@ -64,6 +64,8 @@ def test_unknown_interface_and_no_raw_socket_permission(tmp_path):
     r = in_netns(f"ip link add v0 type veth peer name v1; "
                  f"{' '.join(RENDER)} send {prog} --eth nosuch0")
     assert r.returncode == 1 and "rend3r: error: no such network interface: nosuch0" in r.stderr
+    r = in_netns(f"ip link add v0 type veth peer name v1; {' '.join(RENDER)} send {prog} --eth v0")
+    assert r.returncode == 1 and "the link failed: Network is down" in r.stderr, r.stderr
     if shutil.which("setpriv") is None:
         pytest.skip("needs setpriv(1) to drop CAP_NET_RAW")
     r = in_netns(f"ip link add v0 type veth peer name v1; ip link set v0 up; "

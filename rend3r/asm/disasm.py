@@ -31,7 +31,7 @@ from ..isa.tables import (
     ValueType,
     by_index,
 )
-from .formats.common import address_width
+from .formats.common import address_width, count_words
 from .program import Emitted, Program
 
 #: mode -> (shape mnemonic, the table its property operands name)
@@ -171,7 +171,7 @@ def disassemble(words: list[int], mode: str = "raytrace", addresses: bool = Fals
     lines = disassemble_lines(words, mode)
     width = address_width(len(words))
     mnemonic, table = MODES[mode]
-    out = [f"; rend3r disassembly: {len(words)} words, {mode} mode ({mnemonic} names {table.value} properties)"]
+    out = [f"; rend3r disassembly: {count_words(len(words))}, {mode} mode ({mnemonic} names {table.value} properties)"]
     for line in lines:
         if addresses:
             comment = f"@{line.address:0{width}x} {line.note}".rstrip()

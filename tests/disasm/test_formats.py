@@ -97,11 +97,16 @@ def test_lst_layout():
     ]
 
 
-def test_lst_columns_line_up():
-    rows = render("lst", SAMPLE).decode().splitlines()
-    assert rows[0] == "; rend3r listing of scene.asm: 8 words"
+@pytest.mark.parametrize("program", [SAMPLE, Program([Emitted(0, (0x200,), SourceLoc("a.asm", 1), "nr")]), words_of(1, 2)])
+def test_lst_columns_line_up(program):
+    rows = render("lst", program).decode().splitlines()
     bars = {tuple(i for i, c in enumerate(row) if c == "|")[:3] for row in rows[1:]}
     assert len(bars) == 1
+
+
+def test_lst_labels():
+    rows = render("lst", SAMPLE).decode().splitlines()
+    assert rows[0] == "; rend3r listing of scene.asm: 8 words"
     assert rows[3].split("|")[0].strip() == "4" and rows[4].split("|")[0].strip() == "lib/x.asm:12"
     assert rows[5].split("|")[1:3] == [" 0005 ", " 00000009          "]
 

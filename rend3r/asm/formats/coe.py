@@ -7,7 +7,7 @@ import re
 
 from ...errors import Rend3rError
 from ..program import Program
-from .common import MAX_WORDS, WORD_LIMIT, TextInput
+from .common import MAX_WORDS, WORD_LIMIT, TextInput, count_words
 
 RADIX_KEY = "memory_initialization_radix"
 VECTOR_KEY = "memory_initialization_vector"
@@ -20,7 +20,7 @@ def render_coe(program: Program) -> bytes:
         raise Rend3rError("coe: a memory initialization vector cannot be empty")
     body = ",\n".join(f"{w:08x}" for w in words)
     return (
-        f"; rend3r: {len(words)} words of 32 bits\n{RADIX_KEY}=16;\n{VECTOR_KEY}=\n{body};\n"
+        f"; rend3r: {count_words(len(words))} of 32 bits\n{RADIX_KEY}=16;\n{VECTOR_KEY}=\n{body};\n"
     ).encode("ascii")
 
 

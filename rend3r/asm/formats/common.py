@@ -88,3 +88,8 @@ def unpack_words(data: bytes | bytearray, byteorder: str) -> list[int]:
 def address_width(count: int) -> int:
     """Hex digits for word addresses 0..count-1 (at least 4, so short programs line up)."""
     return max(4, len(f"{max(count - 1, 0):x}"))
+
+
+def count_words(n: int) -> str:
+    """``"1 word"``, ``"5 words"``."""
+    return f"{n} word" if n == 1 else f"{n} words"

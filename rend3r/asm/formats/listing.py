@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 
 from ..program import Program
-from .common import MAX_WORDS, WORD_LIMIT, TextInput, address_width
+from .common import MAX_WORDS, WORD_LIMIT, TextInput, address_width, count_words
 
 WORDS_PER_ROW = 2
 _WORDS_WIDTH = 9 * WORDS_PER_ROW - 1
@@ -27,10 +27,10 @@ def render_lst(program: Program) -> bytes:
         "" if e.loc is None else str(e.loc.line) if e.loc.file == main_file else f"{e.loc.file}:{e.loc.line}"
         for e in entries
     ]
-    line_w = max([4, *map(len, labels)])
+    line_w = max([len("; line"), *map(len, labels)])
     title = f"; rend3r listing of {main_file}" if main_file else "; rend3r listing"
     rows = [
-        f"{title}: {total} words",
+        f"{title}: {count_words(total)}",
         f"; {'line':>{line_w - 2}} | {'addr':<{addr_w}} | {'word(s)':<{_WORDS_WIDTH}} | source",
     ]
     address = 0

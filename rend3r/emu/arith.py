@@ -49,7 +49,7 @@ class Arith:
         if self.precision != "fp16":
             return np.asarray(x, dtype=self.dtype)
         a = np.asarray(x)
-        if a.dtype == np.float32 and a.ndim:
+        if a.dtype == np.float32 and a.size and a.ndim:
             return _round16_f32(a, self.ftz)
         with np.errstate(over="ignore", invalid="ignore"):
             r = a.astype(np.float16).astype(np.float32)  # direct, so no double rounding
@@ -114,15 +114,17 @@ def _round16_f32(a: np.ndarray, ftz: bool) -> np.ndarray:
         r[big] = (b[big] & _SIGN) | np.uint32(_INF_BITS)
         nan = ab > _INF_BITS
         r[nan] = b[nan]
-    if ab.min() < _MIN_NORMAL_BITS:
-        small = ab < _MIN_NORMAL_BITS
-        sign = b[small] & _SIGN
+    small = (ab - np.uint32(1)) < np.uint32(_MIN_NORMAL_BITS - 1)  # nonzero, below float16 normals
+    if small.any():
         if ftz:
-            up = ab[small] >= _FTZ_UP_BITS
-            r[small] = sign | np.where(up, np.uint32(_MIN_NORMAL_BITS), np.uint32(0))
+            tiny = small & (ab < _FTZ_UP_BITS)
+            np.copyto(r, b & _SIGN, where=tiny)
+            up = small & ~tiny
+            if up.any():
+                r[up] = (b[up] & _SIGN) | np.uint32(_MIN_NORMAL_BITS)
         else:
             mag = np.abs(a[small]).astype(np.float16).astype(np.float32)
-            r[small] = mag.view(np.uint32) | sign
+            r[small] = mag.view(np.uint32) | (b[small] & _SIGN)
     return r.view(np.float32)
 
 

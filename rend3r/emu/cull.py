@@ -24,6 +24,9 @@ PAIR_CHUNK = 1 << 19  # pixel-shape pairs computed per batch
 U16 = 2.0**-11  # float16 unit roundoff
 FTZ = 2.0**-14  # largest absolute error of one flush to zero
 _SLACK = 1e-9
+#: A finite float16 a2*c2 is below 65520; with the coefficients' rounding error allowed for,
+#: |D|^2 (|S|^2 - 1) stays below 16380 * 1.02.
+F16_PRODUCT_LIMIT = 16380.0 * 1.02 / (1.0 - 2.0**-6) ** 2
 
 
 @dataclass(frozen=True)
@@ -70,19 +73,23 @@ def shape_bounds(shapes: Shapes) -> Bounds:
     return Bounds(center, smin, smax, ok)
 
 
-def cull_radius(b: Bounds, sel: np.ndarray, dist: np.ndarray, dmin: np.ndarray) -> np.ndarray:
+def cull_radius(b: Bounds, sel: np.ndarray, dist: np.ndarray, dmin: np.ndarray, fp16: bool) -> np.ndarray:
     """World radius beyond which no ray line can hit, for shapes ``sel``.
 
     ``dist`` bounds the distance from ray origins to the centre, ``dmin`` the direction
-    lengths (both broadcast against ``sel``).
+    lengths (both broadcast against ``sel``). In float16 a finite hit needs a2*c2, about
+    4 |D|^2 (|S|^2 - 1), below 65520, which caps the |S| that can still hit.
     """
-    smin, smax = b.smin[sel], b.smax[sel]
-    dhat = smin * dmin  # |D| in normal space, at least
-    u = U16 + FTZ / np.minimum(1.0, dhat * dhat)
-    m = smax * dist
-    h = np.sqrt(1.0 + 24.0 * u * (1.0 + m * m)) + 16.0 * u * m * (1.0 + smax / smin)
-    r = h / smin * (1.0 + _SLACK) + _SLACK
-    return np.where(b.cullable[sel] & (dhat >= 2.0**-4), r, np.inf)
+    with np.errstate(all="ignore"):
+        smin, smax = b.smin[sel], b.smax[sel]
+        dhat = smin * dmin  # |D| in normal space, at least
+        u = U16 + FTZ / np.minimum(1.0, dhat * dhat)
+        m = smax * dist
+        if fp16:
+            m = np.minimum(m, np.sqrt(1.0 + F16_PRODUCT_LIMIT / (dhat * dhat)))
+        h = np.sqrt(1.0 + 24.0 * u * (1.0 + m * m)) + 16.0 * u * m * (1.0 + smax / smin)
+        r = h / smin * (1.0 + _SLACK) + _SLACK
+        return np.where(b.cullable[sel] & (dhat >= 2.0**-4), r, np.inf)
 
 
 def _unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -97,7 +104,7 @@ def _tile_reduce(tiles: Tiles, values: np.ndarray, op: np.ufunc) -> np.ndarray:
 
 
 def cone_keep(tiles: Tiles, apex: np.ndarray, dirs: np.ndarray, origins: np.ndarray | None,
-              b: Bounds, sel: np.ndarray) -> np.ndarray:
+              b: Bounds, sel: np.ndarray, fp16: bool) -> np.ndarray:
     """(tiles, len(sel)) mask: rays through ``apex`` with the tile's directions may hit.
 
     ``dirs`` are the rays' directions and ``origins`` their origins (None: the apex
@@ -112,7 +119,7 @@ def cone_keep(tiles: Tiles, apex: np.ndarray, dirs: np.ndarray, origins: np.ndar
     v = b.center[sel] - apex
     vunit, vlen = _unit(v)
     dist = _origin_distance(tiles, origins, b.center[sel]) if origins is not None else vlen[None, :]
-    r = cull_radius(b, sel, dist, dmin)
+    r = cull_radius(b, sel, dist, dmin, fp16)
     phi = np.arccos(np.clip(axis @ vunit.T, -1.0, 1.0))
     phi = np.minimum(phi, np.pi - phi)  # lines, not half-lines
     with np.errstate(all="ignore"):
@@ -120,7 +127,8 @@ def cone_keep(tiles: Tiles, apex: np.ndarray, dirs: np.ndarray, origins: np.ndar
     return (vlen[None, :] <= r) | (phi <= half[:, None] + spread + 1e-7) | ~np.isfinite(r)
 
 
-def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: Bounds, sel: np.ndarray) -> np.ndarray:
+def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: Bounds, sel: np.ndarray,
+                  fp16: bool) -> np.ndarray:
     """(tiles, len(sel)) mask: parallel rays from the tile's origins (tile order) may hit."""
     d, dlen = _unit(direction)
     e1 = np.cross(d, [1.0, 0.0, 0.0] if abs(d[0]) < 0.9 else [0.0, 1.0, 0.0])
@@ -133,7 +141,7 @@ def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: B
     c2 = b.center[sel] @ basis
     gap = np.maximum(0.0, np.maximum(lo[:, None, :] - c2[None], c2[None] - hi[:, None, :]))
     dist = _origin_distance(tiles, origins, b.center[sel])
-    r = cull_radius(b, sel, dist, np.full((len(tiles), 1), dlen))
+    r = cull_radius(b, sel, dist, np.full((len(tiles), 1), dlen), fp16)
     return (np.linalg.norm(gap, axis=2) <= r) | ~np.isfinite(r)
 
 

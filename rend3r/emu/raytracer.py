@@ -99,11 +99,12 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
     S_shape, _ = to_object(ar, shapes, rays.origin, None)
     c2_shape = origin_term(ar, shapes, S_shape)
     tiles = make_tiles(np.arange(n_pix), options.width)
+    fp16 = ar.precision == "fp16"
     apex = _f64(rays.origin)[0]
     dirs = _f64(rays.direction)[tiles.order] if options.cull else None
     blocks = list(shape_blocks(len(shapes), len(tiles)))
     for done, sel in enumerate(blocks):
-        keep = cone_keep(tiles, apex, dirs, None, bounds, sel) if options.cull else np.ones((len(tiles), len(sel)), bool)
+        keep = cone_keep(tiles, apex, dirs, None, bounds, sel, fp16) if options.cull else np.ones((len(tiles), len(sel)), bool)
         for pix, slot in pairs(tiles, keep, sel):
             s = shapes.take(slot)
             _, Dh = to_object(ar, s, None, _take(rays.direction, pix))
@@ -162,6 +163,7 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
     tmax = ar.const(1.0 if light.kind == POINT else np.inf)
     tmin = ar.const(0.0)
     tiles = make_tiles(pix, options.width)
+    fp16 = ar.precision == "fp16"
     before = st.tests
     if options.cull:
         org = _f64(origin)[tiles.order]
@@ -172,9 +174,9 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
         if not options.cull:
             keep = np.ones((len(tiles), len(sel)), bool)
         elif light.kind == POINT:
-            keep = cone_keep(tiles, apex, dirs, org, bounds, sel)
+            keep = cone_keep(tiles, apex, dirs, org, bounds, sel, fp16)
         else:
-            keep = parallel_keep(tiles, _f64(direction)[0], org, bounds, sel)
+            keep = parallel_keep(tiles, _f64(direction)[0], org, bounds, sel, fp16)
         for pos, slot in pairs(tiles, keep, sel):
             other = slot != own[pos]
             pos, slot = pos[other], slot[other]

@@ -50,17 +50,30 @@ def conj(ar: Arith, q: Quat) -> Quat:
     return (q[0], ar.neg(q[1]), ar.neg(q[2]), ar.neg(q[3]))
 
 
-def _pure(ar: Arith, v: Vec) -> Quat:
-    return (np.zeros((), dtype=ar.dtype), v[0], v[1], v[2])
+def hamilton_pure(ar: Arith, a: Quat, v: Vec) -> Quat:
+    """a * (0, v): :func:`hamilton` with b0 = 0, bit for bit.
+
+    The products with b0 are signed zeros, and adding or subtracting a signed zero to an
+    already rounded value is exact, so those eight steps need no rounding (plain IEEE
+    arithmetic gives the same bits, signs of zero included).
+    """
+    m = ar.mul
+    with np.errstate(invalid="ignore"):
+        z = [np.multiply(c, np.zeros((), ar.dtype)) for c in a]  # a_k * b0
+        r = ar.sub(np.subtract(z[0], m(a[1], v[0])), ar.add(m(a[2], v[1]), m(a[3], v[2])))
+        i = ar.add(np.add(m(a[0], v[0]), z[1]), ar.sub(m(a[2], v[2]), m(a[3], v[1])))
+        j = ar.add(ar.sub(m(a[0], v[1]), m(a[1], v[2])), np.add(z[2], m(a[3], v[0])))
+        k = ar.sub(ar.add(m(a[0], v[2]), m(a[1], v[1])), np.subtract(m(a[2], v[0]), z[3]))
+    return (r, i, j, k)
 
 
 def rotate_inverse(ar: Arith, q: Quat, v: Vec) -> Vec:
     """World to object: conj(q) * (0, v) * q (scaled by |q|^2 when q is not unit)."""
-    w = hamilton(ar, hamilton(ar, conj(ar, q), _pure(ar, v)), q, real=False)
+    w = hamilton(ar, hamilton_pure(ar, conj(ar, q), v), q, real=False)
     return (w[1], w[2], w[3])
 
 
 def rotate(ar: Arith, q: Quat, v: Vec) -> Vec:
     """Object to world: q * (0, v) * conj(q)."""
-    w = hamilton(ar, hamilton(ar, q, _pure(ar, v)), conj(ar, q), real=False)
+    w = hamilton(ar, hamilton_pure(ar, q, v), conj(ar, q), real=False)
     return (w[1], w[2], w[3])

@@ -70,3 +70,16 @@ def test_fast_float32_rounding_matches_numpy_float16_bit_for_bit():
         got, want = ar.round(a), _reference_round16(a, ftz)
         same = (got.view(np.uint32) == want.view(np.uint32)) | (np.isnan(got) & np.isnan(want))
         assert same.all(), hex(int(bits[~same][0]))
+
+
+@given(st.lists(finite16, min_size=7, max_size=7), st.sampled_from(["ftz", "ieee"]))
+def test_hamilton_pure_equals_full_product_bit_for_bit(bits, sub):
+    from rend3r.emu.vec import hamilton, hamilton_pure
+
+    ar = make_arith("fp16", sub)
+    vals = [ar.from_bits(np.array([b])) for b in bits]
+    a, v = tuple(vals[:4]), tuple(vals[4:])
+    full = hamilton(ar, a, (np.zeros(1, np.float32), *v))
+    fast = hamilton_pure(ar, a, v)
+    for x, y in zip(full, fast):
+        assert x.view(np.uint32)[0] == y.view(np.uint32)[0] or (np.isnan(x[0]) and np.isnan(y[0]))

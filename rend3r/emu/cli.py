@@ -1,0 +1,114 @@
+"""``rend3r emulate``: run a program and write its frames as images."""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+from ..errors import Rend3rError
+
+_EPILOG = """\b
+Examples:
+  rend3r emulate programs/sphere.asm -o sphere.png
+  rend3r emulate programs/animation.asm --frames 24 -o out/frame_{n:03}.png --gif anim.gif
+  rend3r emulate sphere.mem -o s.png --precision fp32 --size 256x192 --depth d.png --stats
+"""
+
+
+def _size(ctx, param, value: str) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in value.lower().split("x"))
+    except ValueError:
+        raise click.BadParameter(f"expected WIDTHxHEIGHT such as 512x384, not {value!r}") from None
+    if not (1 <= w <= 8192 and 1 <= h <= 8192):
+        raise click.BadParameter(f"width and height must be 1..8192, not {value!r}")
+    return w, h
+
+
+def _colour(ctx, param, value: str) -> int:
+    try:
+        c = int(value.replace("_", ""), 0)
+    except ValueError:
+        raise click.BadParameter(f"expected an RGB565 value such as 0x001F, not {value!r}") from None
+    if not 0 <= c <= 0xFFFF:
+        raise click.BadParameter(f"RGB565 colours are 16 bits, {value!r} is not")
+    return c
+
+
+@click.command("emulate", epilog=_EPILOG)
+@click.argument("program", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", help="PNG per frame: a name, or a pattern like out/frame_{n:03}.png for several.")
+@click.option("--frames", type=int, help="Render at most N frames (required for programs that loop with lr).")
+@click.option("--mode", type=click.Choice(["raytrace", "raster"]), help="How SE/SD data is read (default: from the source's sp/tr, else raytrace).")
+@click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
+@click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormals: flush to zero (the device's IP) or IEEE gradual underflow.")
+@click.option("--size", default="512x384", show_default=True, callback=_size, help="Image size WxH.")
+@click.option("--background", default="0x0000", show_default=True, callback=_colour, help="RGB565 colour where no shape is hit.")
+@click.option("--depth", "depth_path", help="Depth image per frame: .npy (float32 distances) or 16-bit PNG.")
+@click.option("--provenance", "prov_path", help="Which shape made each pixel: .npy (int32, -1 none) or PNG.")
+@click.option("--gif", "gif_path", help="All frames as an animated GIF.")
+@click.option("--apng", "apng_path", help="All frames as an animated PNG (lossless).")
+@click.option("--stats", "show_stats", is_flag=True, help="Print counters, times and the paper's device estimate.")
+def emulate_command(program, output, frames, mode, precision, subnormals, size, background,
+                    depth_path, prov_path, gif_path, apng_path, show_stats) -> None:
+    """Run a REND3R PROGRAM (source or memory image) and render its frames."""
+    from .image import frame_path, is_pattern, save_animation, save_depth, save_png, save_provenance
+    from .loader import load_program
+    from .options import EmuOptions
+    from .processor import execute
+    from .run import run_program
+
+    if gif_path and apng_path:
+        raise Rend3rError("--gif and --apng are exclusive: choose one animation format")
+    if not (output or gif_path or apng_path):
+        raise Rend3rError("nothing to write: give -o OUT (and/or --gif/--apng)")
+    loaded = load_program(program)
+    options = EmuOptions(precision=precision, subnormals=subnormals, mode=mode or loaded.mode_hint or "raytrace",
+                         width=size[0], height=size[1], background=background)
+    count = execute(loaded.words, options, frames).frames
+    if count == 0:
+        raise Rend3rError(f"{program}: the program renders no frame (no nf is executed)")
+    for opt, path in (("-o", output), ("--depth", depth_path), ("--provenance", prov_path)):
+        if path and count > 1 and not is_pattern(path):
+            raise Rend3rError(f"the program renders {count} frames: {opt} needs a pattern such as out/frame_{{n:03}}.png")
+    animate = gif_path or apng_path
+    bar = _progress_bar(count)
+    rgb_frames = []
+
+    def on_frame(frame) -> None:
+        if output:
+            save_png(frame.rgb565, frame_path(output, frame.number))
+        if depth_path:
+            save_depth(frame.depth, frame_path(depth_path, frame.number))
+        if prov_path:
+            save_provenance(frame.provenance, frame_path(prov_path, frame.number))
+        if animate:
+            rgb_frames.append(frame.rgb565)
+
+    def progress(number: int, fraction: float) -> None:
+        if bar is not None:
+            bar.update(int((number + fraction) * 1000) - bar.pos)
+
+    try:
+        result = run_program(loaded.words, options, frames, on_frame, progress, keep_frames=False)
+    finally:
+        if bar is not None:
+            bar.render_finish()
+    if animate:
+        save_animation(rgb_frames, animate, "gif" if gif_path else "apng")
+    nan = result.stats.nan_rays
+    if nan:
+        click.echo(f"rend3r: warning: {nan} rays met NaN or infinity and were counted as misses "
+                   f"({int(result.stats.total('nan_tests'))} shape tests); see --stats", err=True)
+    if show_stats:
+        click.echo(result.stats.report())
+
+
+def _progress_bar(frames: int):
+    """A progress bar on stderr when it is a terminal (units: thousandths of a frame)."""
+    if not sys.stderr.isatty():
+        return None
+    bar = click.progressbar(length=frames * 1000, label="rendering", file=sys.stderr)
+    bar.render_progress()
+    return bar

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import signal
 import subprocess
 import sys
@@ -82,3 +81,17 @@ def test_device_stops_on_sigint(tmp_path):
     device.send_signal(signal.SIGINT)
     _, err = device.communicate(timeout=30)
     assert device.returncode == 0 and "stopped after 0 loads" in err
+
+
+@pytest.mark.timeout(120)
+def test_device_size_limit_is_reported_to_the_sender(pty_bridge, tmp_path):
+    device = start_device(["--serial", pty_bridge.paths[1], "-o", str(tmp_path / "o"),
+                           "--max-words", "4"])
+    try:
+        r = subprocess.run(RENDER + ["send", str(PROGRAMS / "sphere.asm"), "--serial",
+                                     pty_bridge.paths[0]], capture_output=True, text=True, timeout=60)
+    finally:
+        err = stop_device(device)
+    assert r.returncode == 1
+    assert "the device refuses a program of" in r.stderr and "its limit is 4" in r.stderr
+    assert "NACKs: TOO_LARGE 1" in err

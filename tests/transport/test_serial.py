@@ -139,3 +139,43 @@ def test_missing_and_busy_ports(pty_bridge, tmp_path):
     finally:
         held.close()
     assert r.returncode == 1 and "is busy" in r.stderr, r.stderr
+
+
+@pytest.mark.timeout(60)
+def test_sender_over_a_socket_url(serial_device):
+    """``socket://``: a TCP server relays to the pty the device listens on (like ser2net)."""
+    import os
+    import select
+    import socket
+
+    core, _, path = serial_device
+    server = socket.create_server(("127.0.0.1", 0))
+    port = server.getsockname()[1]
+    fd = os.open(path, os.O_RDWR | os.O_NOCTTY)
+    stop = threading.Event()
+
+    def relay() -> None:
+        conn, _ = server.accept()
+        with conn:
+            while not stop.is_set():
+                for ready in select.select([conn, fd], [], [], 0.05)[0]:
+                    if ready is conn:
+                        data = conn.recv(65536)
+                        if not data:
+                            return
+                        os.write(fd, data)
+                    else:
+                        conn.sendall(os.read(fd, 65536))
+
+    thread = threading.Thread(target=relay, daemon=True)
+    thread.start()
+    words = list(range(700))
+    try:
+        with SerialLink(open_serial(f"socket://127.0.0.1:{port}")) as link:
+            Sender(link, timeout=0.5).load(words)
+    finally:
+        stop.set()
+        thread.join()
+        server.close()
+        os.close(fd)
+    assert core.active == tuple(words)

@@ -1,0 +1,133 @@
+"""rend3r emulate end to end: real files in, real images out (CliRunner)."""
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from PIL import Image
+
+from rend3r.cli import main
+from rend3r.emu.image import rgb565_to_rgb888
+from rend3r.emu.options import EmuOptions
+from rend3r.emu.run import run_program
+
+from .scenes import Prog
+
+SRC = """\
+nr
+cam hfov, 0.3
+cam vfov, 0.3
+lt 0, src, 1
+lt 0, zfor, -1
+sp 0, type, col, 1, 0xF800
+sp 0, zloc, rrot, -3, 1
+sp 0, xscl, yscl, 1, 1
+sp 0, zscl, zero, 1, 0
+nf
+er
+"""
+
+
+def _run(*args, **kw):
+    result = CliRunner().invoke(main, ["emulate", *map(str, args)], **kw)
+    return result
+
+
+@pytest.fixture
+def src(tmp_path):
+    p = tmp_path / "s.asm"
+    p.write_text(SRC)
+    return p
+
+
+def test_png_is_the_frame_buffer_with_bit_replication(tmp_path, src):
+    out = tmp_path / "f.png"
+    r = _run(src, "-o", out, "--size", "40x30")
+    assert r.exit_code == 0, r.output
+    from rend3r.emu.loader import load_program
+
+    frame = run_program(load_program(src).words, EmuOptions(width=40, height=30)).frames[0]
+    img = np.asarray(Image.open(out).convert("RGB"))
+    assert img.shape == (30, 40, 3)
+    assert (img == rgb565_to_rgb888(frame.rgb565)).all()
+    assert (frame.rgb565 != 0).any()
+
+
+def test_memory_image_input_and_background(tmp_path):
+    mem = tmp_path / "p.mem"
+    words = Prog().nr().sphere(0).nf().er().words
+    mem.write_text("".join(f"{w:08x}\n" for w in words))
+    out = tmp_path / "f.png"
+    r = _run(mem, "-o", out, "--size", "16x12", "--background", "0x001F")
+    assert r.exit_code == 0, r.output
+    assert tuple(np.asarray(Image.open(out).convert("RGB"))[0, 0]) == (0, 0, 255)
+
+
+def test_several_frames_need_a_pattern_then_write_each_and_a_gif(tmp_path):
+    src = tmp_path / "loop.asm"
+    src.write_text("nr\nsp 0, type, zloc, 1, -3\nsp 0, xscl, yscl, 1, 1\nsp 0, zscl, col, 1, 0xffff\nnf\nlr\n")
+    r = _run(src, "-o", tmp_path / "x.png", "--size", "16x12")
+    assert r.exit_code == 1 and "loops" in r.output and "--frames" in r.output
+    r = _run(src, "--frames", 3, "-o", tmp_path / "x.png", "--size", "16x12")
+    assert r.exit_code == 1 and "pattern" in r.output
+    anim = tmp_path / "anim.asm"
+    anim.write_text("nr\nsp 0, type, zloc, 1, -3\nsp 0, xscl, yscl, 1, 1\nsp 0, zscl, col, 1, 0xffff\nnf\n"
+                    "sp 0, xloc, zero, 1, 0\nnf\nsp 0, xloc, zero, 2, 0\nnf\ner\n")
+    r = _run(anim, "-o", tmp_path / "out" / "f_{n:02}.png", "--gif", tmp_path / "a.gif",
+             "--depth", tmp_path / "d_{n}.npy", "--provenance", tmp_path / "p_{n}.png", "--size", "16x12")
+    assert r.exit_code == 0, r.output
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["f_00.png", "f_01.png", "f_02.png"]
+    gif = Image.open(tmp_path / "a.gif")
+    assert gif.n_frames == 3
+    depth = np.load(tmp_path / "d_1.npy")
+    assert depth.dtype == np.float32 and depth.shape == (12, 16) and np.isfinite(depth).any()
+    assert Image.open(tmp_path / "p_2.png").size == (16, 12)
+
+
+def test_apng_depth_png_and_stats(tmp_path, src):
+    r = _run(src, "--apng", tmp_path / "a.png", "--depth", tmp_path / "d.png", "--provenance",
+             tmp_path / "p.npy", "--stats", "--size", "32x24", "--precision", "fp32")
+    assert r.exit_code == 0, r.output
+    assert "device estimate" in r.output and "rays 768" in r.output
+    d = np.asarray(Image.open(tmp_path / "d.png"))
+    assert d.dtype.kind in "iu" and d.max() == 65535 and d.min() == 0
+    prov = np.load(tmp_path / "p.npy")
+    assert set(np.unique(prov)) == {-1, 0}
+
+
+def test_nan_rays_are_reported_on_stderr(tmp_path):
+    src = tmp_path / "bad.asm"
+    src.write_text("nr\nsp 0, type, zloc, 1, -3\nnf\ner\n")  # inverse scales left at zero
+    r = _run(src, "-o", tmp_path / "f.png", "--size", "8x6")
+    assert r.exit_code == 0
+    assert "warning: 48 rays met NaN or infinity" in r.stderr
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--size", "12"], "WIDTHxHEIGHT"),
+    (["--background", "0x10000"], "16 bits"),
+    (["--gif", "a.gif", "--apng", "b.png"], "exclusive"),
+    ([], "nothing to write"),
+])
+def test_argument_errors(tmp_path, src, args, message):
+    r = _run(src, *args)
+    assert r.exit_code != 0 and message in r.output
+
+
+def test_errors_in_the_program_name_the_address(tmp_path):
+    mem = tmp_path / "p.mem"
+    mem.write_text("00000200\n00000006\n")
+    r = _run(mem, "-o", tmp_path / "f.png")
+    assert r.exit_code == 1 and "address 1 (0x0001): unknown opcode" in r.output
+    assert not (tmp_path / "f.png").exists()
+
+
+def test_program_without_nf(tmp_path):
+    src = tmp_path / "n.asm"
+    src.write_text("nr\ner\n")
+    r = _run(src, "-o", tmp_path / "f.png")
+    assert r.exit_code == 1 and "no frame" in r.output
+
+
+def test_help_shows_an_example():
+    r = _run("--help")
+    assert r.exit_code == 0 and "rend3r emulate programs/sphere.asm -o sphere.png" in r.output

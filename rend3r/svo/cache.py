@@ -49,6 +49,8 @@ def simulate(addr: np.ndarray, level: np.ndarray | None, cfg: CacheConfig) -> np
     use = np.ones(len(addr), dtype=bool) if cfg.max_level is None or level is None \
         else np.asarray(level) <= cfg.max_level
     pos = np.flatnonzero(use)
+    if len(pos) == 0:
+        return hits
     blk = addr[pos] // cfg.block
     sets = blk % cfg.sets
     order = np.argsort(sets, kind="stable")

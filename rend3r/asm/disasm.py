@@ -7,11 +7,12 @@ that decode to nothing become ``.word`` directives with a comment giving the rea
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
 from ..isa.encoding import is_canonical
-from ..isa.float16 import bits_to_float, round_literal, shortest_repr
+from ..isa.float16 import bits_to_float, is_subnormal, round_literal, shortest_repr
 from ..isa.tables import (
     DATA,
     F_MNEMONICS,
@@ -67,6 +68,7 @@ def format_value(prop: Property, bits: int) -> str:
     return str(bits)
 
 
+@lru_cache(maxsize=None)
 def float_operand(bits: int) -> str:
     """The shortest decimal that rounds back to ``bits`` without the assembler's
     precision warning; ``0hXXXX`` for NaN and infinities.
@@ -78,6 +80,9 @@ def float_operand(bits: int) -> str:
     text = shortest_repr(bits)
     if text is None:
         return f"0h{bits:04x}"
+    if not is_subnormal(bits):
+        # A normal value's shortest decimal lies within half an ulp: under 2**-11 off.
+        return text
     digits = 1
     while _loss(text) > LOSS_WARNING:
         digits += 1

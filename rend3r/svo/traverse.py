@@ -179,12 +179,14 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
         out_stack[r] = st["maxstack"][sel]
 
     iteration = 0
-    while len(st["rid"]):
+    alive = np.ones(m, dtype=bool)
+    n_alive = m
+    while n_alive:
         iteration += 1
         if iteration > limit:
             raise RuntimeError("traversal did not terminate (bug)")
         t0, t1, idx, word = st["t0"], st["t1"], st["idx"], st["word"]
-        st["steps"] += 1
+        st["steps"] += alive
         tsum = t0 + t1
         tm = tsum >> 1 if fixed else tsum * 0.5
         bits = ((idx[:, None] >> np.array([2, 1, 0])) & 1).astype(bool)
@@ -195,9 +197,9 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
         valid = (word >> (8 + cidx)) & 1
         leaf = (word >> cidx) & 1
         passed = texit <= st["tstart"]
-        hit = ~passed & (leaf == 1)
-        desc = ~passed & (leaf == 0) & (valid == 1)
-        nxt = ~(hit | desc)
+        hit = ~passed & (leaf == 1) & alive
+        desc = ~passed & (leaf == 0) & (valid == 1) & alive
+        nxt = ~(hit | desc) & alive
         done = hit.copy()
 
         if hit.any():
@@ -322,8 +324,13 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
 
         if done.any():
             finish(done)
-            keep = ~done
-            st = {k: v[keep] for k, v in st.items()}
+            alive &= ~done
+            n_alive = int(alive.sum())
+            # compact only when many rays have finished: copying every state array each
+            # iteration would cost more than carrying finished rays for a while
+            if n_alive < 0.7 * len(alive):
+                st = {k: v[alive] for k, v in st.items()}
+                alive = np.ones(n_alive, dtype=bool)
 
     voxel = np.full((n, 3), -1, dtype=np.int64)
     voxel[out_hit] = morton_decode(out_code[out_hit], tree.depth)

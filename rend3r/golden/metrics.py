@@ -62,12 +62,15 @@ class ImageMetrics:
         )
 
 
-def image_metrics(a: np.ndarray, b: np.ndarray) -> ImageMetrics:
-    """Colour metrics of ``b`` against reference ``a`` (RGB565 buffers or RGB888 images)."""
+def image_metrics(a: np.ndarray, b: np.ndarray, mask: np.ndarray | None = None) -> ImageMetrics:
+    """Colour metrics of ``b`` against reference ``a`` (RGB565 buffers or RGB888 images),
+    over all pixels or only those where the (H, W) boolean ``mask`` is set."""
     x = as_rgb888(a).astype(np.int16)
     y = as_rgb888(b).astype(np.int16)
     if x.shape != y.shape:
         raise ValueError(f"image sizes differ: {x.shape[1]}x{x.shape[0]} vs {y.shape[1]}x{y.shape[0]}")
+    if mask is not None:
+        x, y = x[mask][None], y[mask][None]
     d = np.abs(x - y)
     pixels = x.shape[0] * x.shape[1]
     differing = int(np.count_nonzero(d.max(axis=-1))) if pixels else 0
@@ -118,6 +121,22 @@ def interior_mask(provenance: np.ndarray) -> np.ndarray:
             all_hit &= window
             any_hit |= window
     return all_hit | ~any_hit
+
+
+def region_interior_mask(provenance: np.ndarray) -> np.ndarray:
+    """Pixels whose whole 3x3 neighbourhood saw the same shape (or all missed).
+
+    Away from every silhouette, including edges where one shape occludes another, a
+    pixel's colour depends only on shading, so colour bounds are meaningful there.
+    """
+    prov = np.asarray(provenance)
+    padded = np.pad(prov, 1, mode="edge")
+    h, w = prov.shape
+    same = np.ones(prov.shape, dtype=bool)
+    for dy in range(3):
+        for dx in range(3):
+            same &= padded[dy : dy + h, dx : dx + w] == prov
+    return same
 
 
 def diff_image(a: np.ndarray, b: np.ndarray) -> np.ndarray:

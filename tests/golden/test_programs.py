@@ -2,16 +2,22 @@
 
 from __future__ import annotations
 
+from functools import lru_cache
 from pathlib import Path
 
 import pytest
 
-from rend3r.asm.assembler import assemble_file
+from rend3r.asm.assembler import AssemblyResult, assemble_file
 from rend3r.golden.catalog import discover, read_header
 from rend3r.isa import PROPERTIES, CameraSet, FrameOp, LightSet, ShapeSet, Table, decode_stream
 
 PROGRAMS_DIR = Path(__file__).resolve().parents[2] / "programs"
 PROGRAMS = discover(PROGRAMS_DIR)
+
+@lru_cache(maxsize=None)
+def assembled(path: Path) -> AssemblyResult:
+    return assemble_file(path)
+
 
 #: Warnings a program provokes on purpose (program name -> substring).
 EXPECTED_WARNINGS = {"registers": "second value wins"}
@@ -19,7 +25,7 @@ EXPECTED_WARNINGS = {"registers": "second value wins"}
 
 @pytest.mark.parametrize("program", PROGRAMS, ids=[p.name for p in PROGRAMS])
 def test_program_assembles(program) -> None:
-    result = assemble_file(program.path)
+    result = assembled(program.path)
     assert result.ok, result.format_diagnostics()
     text = result.format_diagnostics()
     if program.name in EXPECTED_WARNINGS:
@@ -32,7 +38,7 @@ def test_programs_cover_every_instruction_and_property() -> None:
     used: dict[Table, set[int]] = {t: set() for t in Table}
     funcs = set()
     for program in PROGRAMS:
-        words = list(assemble_file(program.path).program.words)
+        words = list(assembled(program.path).program.words)
         table = Table.TRIANGLE if program.mode == "raster" else Table.SHAPE
         for _, ins in decode_stream(words):
             if isinstance(ins, FrameOp):

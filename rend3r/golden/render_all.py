@@ -1,0 +1,98 @@
+"""``rend3r render-all``: render every example program's frames to PNG files."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import click
+
+from ..errors import Rend3rError
+from .catalog import ExampleProgram, discover
+from .compare import parse_size
+
+if TYPE_CHECKING:
+    from ..emu import EmuOptions, Frame
+
+
+def render_example(program: ExampleProgram, options: EmuOptions) -> list[Frame]:
+    """Assemble/load ``program`` and render its frames (RGB565, depth, provenance).
+
+    The mode comes from the program's header, else from the emulator's hint (``tr`` in the
+    source means raster), else ``options.mode``.
+    """
+    from ..emu import load_program, run_program
+
+    loaded = load_program(program.path)
+    mode = program.mode or loaded.mode_hint or options.mode
+    result = run_program(loaded.words, options=replace(options, mode=mode), frames=program.frames)
+    if len(result.frames) != program.frames:
+        raise Rend3rError(f"{program.path}: rendered {len(result.frames)} frame(s), header says frames: {program.frames}")
+    return list(result.frames)
+
+
+def render_all(
+    programs_dir: Path, out_dir: Path, options: EmuOptions, echo: Callable[[str], None] = print
+) -> list[str]:
+    """Render every program in ``programs_dir`` to ``out_dir/<name>[.NNN].png``.
+
+    Prints one progress line per program; a program that fails is reported and skipped.
+    Returns the names of the programs that failed.
+    """
+    from ..emu.image import save_png
+
+    programs = discover(programs_dir)
+    if not programs:
+        raise Rend3rError(f"no *.asm programs in {programs_dir}")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    failed: list[str] = []
+    for n, program in enumerate(programs, 1):
+        prefix = f"[{n}/{len(programs)}] {program.name}:"
+        start = time.perf_counter()
+        try:
+            frames = render_example(program, options)
+        except Rend3rError as exc:
+            echo(f"{prefix} FAILED: {exc}")
+            failed.append(program.name)
+            continue
+        for i, frame in enumerate(frames):
+            save_png(frame.rgb565, out_dir / f"{program.frame_name(i)}.png")
+        elapsed = time.perf_counter() - start
+        plural = "s" if len(frames) != 1 else ""
+        echo(
+            f"{prefix} {len(frames)} frame{plural} {options.width}x{options.height} "
+            f"{options.arith.label} in {elapsed:.2f} s -> {out_dir / program.frame_name(0)}.png"
+            + (" ..." if len(frames) > 1 else "")
+        )
+    return failed
+
+
+@click.command("render-all")
+@click.argument("programs_dir", type=click.Path(path_type=Path, file_okay=False), default="programs")
+@click.option("-o", "--out", "out_dir", type=click.Path(path_type=Path, file_okay=False), required=True, help="Folder for the PNGs.")
+@click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
+@click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormal handling.")
+@click.option("--size", "size_text", default="512x384", show_default=True, metavar="WxH", help="Image size.")
+def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnormals: str, size_text: str) -> None:
+    """Render every PROGRAMS_DIR/*.asm (default: programs) to PNGs in OUT.
+
+    Each program's header sets its frame count (``; frames: N``) and mode. Files are
+    named after the program, with the frame number for animations
+    (``animation.000.png``). Exit status 1 if any program failed.
+
+    \b
+    Example:
+      rend3r render-all programs -o out/ --precision fp16
+    """
+    from ..emu import EmuOptions
+
+    if not programs_dir.is_dir():
+        raise Rend3rError(f"{programs_dir} is not a folder")
+    width, height = parse_size(size_text)
+    options = EmuOptions(precision=precision, subnormals=subnormals, width=width, height=height)
+    failed = render_all(programs_dir, out_dir, options, echo=click.echo)
+    if failed:
+        raise Rend3rError(f"{len(failed)} program(s) failed: {', '.join(failed)}")

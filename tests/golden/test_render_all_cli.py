@@ -1,0 +1,49 @@
+"""``rend3r render-all`` on real program files."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+from click.testing import CliRunner
+from PIL import Image
+
+from rend3r.cli import main
+
+PROGRAMS_DIR = Path(__file__).resolve().parents[2] / "programs"
+
+
+def test_renders_every_program_and_frame(tmp_path: Path) -> None:
+    src = tmp_path / "progs"
+    src.mkdir()
+    for name in ("sphere.asm", "animation.asm"):
+        shutil.copy(PROGRAMS_DIR / name, src / name)
+    out = tmp_path / "out"
+    r = CliRunner().invoke(main, ["render-all", str(src), "-o", str(out), "--size", "32x24", "--precision", "fp32"])
+    assert r.exit_code == 0, r.output
+    assert "[1/2] animation: 8 frames 32x24 fp32" in r.output and "[2/2] sphere: 1 frame 32x24 fp32" in r.output
+    names = sorted(p.name for p in out.iterdir())
+    assert names == [f"animation.{i:03d}.png" for i in range(8)] + ["sphere.png"]
+    sphere = np.asarray(Image.open(out / "sphere.png"))
+    assert sphere.shape == (24, 32, 3) and sphere[..., 0].max() > 100  # the red sphere is there
+    frames = [np.asarray(Image.open(out / f"animation.{i:03d}.png")) for i in range(8)]
+    assert not np.array_equal(frames[0], frames[2])  # it moves
+
+
+def test_failing_program_is_reported_and_others_still_render(tmp_path: Path) -> None:
+    (tmp_path / "bad.asm").write_text("; bad.asm: broken\nsp 0, nosuchprop, type, 1, 1\n", encoding="utf-8")
+    shutil.copy(PROGRAMS_DIR / "sphere.asm", tmp_path / "sphere.asm")
+    out = tmp_path / "out"
+    r = CliRunner().invoke(main, ["render-all", str(tmp_path), "-o", str(out), "--size", "16x12"])
+    assert r.exit_code == 1
+    assert "[1/2] bad: FAILED" in r.output and "nosuchprop" in r.output
+    assert "1 program(s) failed: bad" in r.output
+    assert (out / "sphere.png").exists() and not (out / "bad.png").exists()
+
+
+def test_empty_or_missing_folder(tmp_path: Path) -> None:
+    r = CliRunner().invoke(main, ["render-all", str(tmp_path), "-o", str(tmp_path / "o")])
+    assert r.exit_code == 1 and "no *.asm programs" in r.output
+    r = CliRunner().invoke(main, ["render-all", str(tmp_path / "missing"), "-o", str(tmp_path / "o")])
+    assert r.exit_code == 1 and "is not a folder" in r.output

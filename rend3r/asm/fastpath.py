@@ -143,7 +143,12 @@ def _value(mnemonic: str, name: str, text: str) -> tuple[int, int] | None:
         known[name] = info
     if info is None:
         return None
-    bits = _float_bits(text) if info[1] == 0 else _int_bits(text, info[1])
+    if info[1]:
+        bits = _int_bits(text, info[1])
+    else:
+        bits = _FLOAT_BITS.get(text, -1)
+        if bits == -1:
+            bits = _float_bits(text)
     return None if bits is None else (info[0], bits)
 
 
@@ -182,19 +187,19 @@ def fast_line(text: str, limits: dict[str, int] | None = None) -> tuple | None:
         ):
             return None
         se = (index >> 3) << _SEHI | pv[0] << _PROP | qw[0] << _SEP2 | (index & 7) << _SELO | _SE_BASE
-        return mn, (se, pv[1] << _SD1 | qw[1] << _SD2), m.start("s") + 1
+        return mn, (se, pv[1] << _SD1 | qw[1] << _SD2), m.start(9) + 1
     if lt:
         index = int(li)
         pv = _value("lt", lp, lv)
         if pv is None or index >= LIGHT_INDEX_LIMIT or (limits and index >= limits["lt"]):
             return None
-        return "lt", (pv[1] << _DATA | pv[0] << _PROP | index << _LIDX | _L_BASE,), m.start("l") + 1
+        return "lt", (pv[1] << _DATA | pv[0] << _PROP | index << _LIDX | _L_BASE,), m.start(5) + 1
     if c:
         pv = _value("cam", cp, cv)
         if pv is None:
             return None
-        return "cam", (pv[1] << _DATA | pv[0] << _PROP | _C_BASE,), m.start("c") + 1
+        return "cam", (pv[1] << _DATA | pv[0] << _PROP | _C_BASE,), m.start(2) + 1
     if f:
         mn = f.lower()
-        return mn, (_F_WORDS[mn],), m.start("f") + 1
+        return mn, (_F_WORDS[mn],), m.start(1) + 1
     return ()

@@ -71,9 +71,10 @@ def _value(scene: Scene, name: str, arith: Arith, default: float) -> np.ndarray:
 
 
 def camera_quaternion(scene: Scene, arith: Arith) -> Quat | None:
-    """The camera's rotation, normalised; None when all four are zero (no rotation)."""
+    """The camera's rotation, normalised; None for no rotation (i = j = k = 0, which
+    includes the all-zero quaternion of unset memory)."""
     q = [arith.from_bits(scene.camera_bits(n)) for n in ("rrot", "irot", "jrot", "krot")]
-    if all(float(c) == 0.0 for c in q):
+    if all(float(c) == 0.0 for c in q[1:]):
         return None
     r, i, j, k = q
     norm2 = arith.add(arith.add(arith.mul(r, r), arith.mul(i, i)), arith.add(arith.mul(j, j), arith.mul(k, k)))

@@ -20,7 +20,7 @@ import numpy as np
 from .shapes import Shapes
 
 TILE = 16  # pixels per tile side
-PAIR_CHUNK = 1 << 19  # pixel-shape pairs computed per batch
+PAIR_CHUNK = 1 << 16  # pixel-shape pairs per batch: temporaries stay cache-sized
 U16 = 2.0**-11  # float16 unit roundoff
 FTZ = 2.0**-14  # largest absolute error of one flush to zero
 _SLACK = 1e-9

@@ -19,7 +19,8 @@ from .frame import Frame
 from .lights import POINT, Light, lights_from_scene
 from .options import EmuOptions
 from .scene import Scene
-from .shapes import Shapes, origin_term, shapes_from_scene, solve, squared_distance, surface, to_object
+from .shapes import (Form, Shapes, direction_term, origin_term, shapes_from_scene, solve, squared_distance, surface,
+                     to_object, transform_classes)
 from .stats import FrameStats
 from .vec import Vec, dot, sub3
 
@@ -42,14 +43,18 @@ class _Nearest:
     def __init__(self, n: int, dtype: type) -> None:
         self.sqd = np.full(n, np.inf, dtype=dtype)
         self.slot = np.full(n, _NONE, dtype=np.int64)
+        self.t = np.full(n, np.nan, dtype=dtype)  # the winner's t
 
-    def update(self, pix: np.ndarray, slot: np.ndarray, sqd: np.ndarray) -> None:
+    def update(self, pix: np.ndarray, slot: np.ndarray, sqd: np.ndarray, t: np.ndarray | None = None) -> None:
         before = self.sqd[pix]
         np.minimum.at(self.sqd, pix, sqd)
         now = self.sqd[pix]
         self.slot[pix[now < before]] = _NONE
         tie = sqd == now
         np.minimum.at(self.slot, pix[tie], slot[tie])
+        if t is not None:
+            won = tie & (self.slot[pix] == slot)
+            self.t[pix[won]] = t[won]
 
 
 def render_frame(
@@ -70,14 +75,18 @@ def render_frame(
     if len(shapes):
         bounds = shape_bounds(shapes)
         dd = dot(ar, rays.direction, rays.direction)
-        near = _primary(ar, options, rays, dd, shapes, bounds, st, nan_pixel, progress)
+        near, tables, S_shape = _primary(ar, options, rays, dd, shapes, bounds, st, nan_pixel, progress)
         hp = np.nonzero(near.slot != _NONE)[0]
         slot = near.slot[hp]
         s = shapes.take(slot)
         D = _take(rays.direction, hp)
-        S, Dh = to_object(ar, s, rays.origin, D)
-        sol = solve(ar, s, S, Dh, origin_term(ar, s, S), rays.tmin, rays.tmax)
-        point, normal = surface(ar, s, S, Dh, sol.t, rays.origin, D)
+        if tables is None:
+            _, Dh = to_object(ar, s, None, D)
+        else:
+            cls, n, tab = tables
+            row = cls[slot] * n + hp
+            Dh = (tab[0][row], tab[1][row], tab[2][row])
+        point, normal = surface(ar, s, _take(S_shape, slot), Dh, near.t[hp], rays.origin, D)
         color, bad = _shade(ar, options, shapes, bounds, lights, hp, slot, point, normal, st, nan_pixel)
         nan_pixel[hp[bad]] = True
         hp, slot = hp[~bad], slot[~bad]
@@ -91,13 +100,39 @@ def render_frame(
     return frame, st
 
 
+#: Per-class direction tables are built when classes * pixels stays below this.
+_CLASS_TABLE_LIMIT = 1 << 23
+
+
+def _direction_tables(ar: Arith, shapes: Shapes, direction: Vec):
+    """Normal-space directions and a2 per (transform class, pixel), or None if too large.
+
+    A pair then reads its class's row instead of repeating the rotation: bit-identical,
+    since it is the same sequence of operations on the same values.
+    """
+    first, cls = transform_classes(shapes)
+    n = len(direction[0])
+    if len(first) * n > _CLASS_TABLE_LIMIT:
+        return None
+    rows = []
+    for rep in first:
+        s = shapes.take(np.array([rep]))
+        _, Dh = to_object(ar, s, None, direction)
+        rows.append((*Dh, direction_term(ar, s, Dh)))
+    tables = [np.concatenate([r[k] for r in rows]) for k in range(4)]
+    return cls, n, tables
+
+
 def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: Bounds,
-             st: FrameStats, nan_pixel: np.ndarray, progress: Progress | None) -> _Nearest:
-    """Nearest hit of every primary ray; the ray origin's normal-space terms are per shape."""
+             st: FrameStats, nan_pixel: np.ndarray, progress: Progress | None):
+    """Nearest hit of every primary ray; origin terms are per shape, direction terms per
+    transform class and pixel. Returns the nearest hits, the direction tables (or None)
+    and the per-shape normal-space origins."""
     n_pix = options.pixels
     near = _Nearest(n_pix, ar.dtype)
     S_shape, _ = to_object(ar, shapes, rays.origin, None)
     c2_shape = origin_term(ar, shapes, S_shape)
+    tables = _direction_tables(ar, shapes, rays.direction)
     tiles = make_tiles(np.arange(n_pix), options.width)
     fp16 = ar.precision == "fp16"
     apex = _f64(rays.origin)[0]
@@ -106,20 +141,27 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
     for done, sel in enumerate(blocks):
         keep = cone_keep(tiles, apex, dirs, None, bounds, sel, fp16) if options.cull else np.ones((len(tiles), len(sel)), bool)
         for pix, slot in pairs(tiles, keep, sel):
-            s = shapes.take(slot)
-            _, Dh = to_object(ar, s, None, _take(rays.direction, pix))
-            sol = solve(ar, s, _take(S_shape, slot), Dh, c2_shape[slot], rays.tmin, rays.tmax)
+            if tables is None:
+                s = shapes.take(slot)
+                _, Dh = to_object(ar, s, None, _take(rays.direction, pix))
+                a2 = None
+            else:
+                s = Form(shapes.zsign[slot])
+                cls, n, tab = tables
+                row = cls[slot] * n + pix
+                Dh, a2 = (tab[0][row], tab[1][row], tab[2][row]), tab[3][row]
+            sol = solve(ar, s, _take(S_shape, slot), Dh, c2_shape[slot], rays.tmin, rays.tmax, a2)
             sqd = squared_distance(ar, dd[pix], sol.t)
             bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
             hit = sol.hit & ~bad
             st.tests += len(pix)
             st.nan_tests += int(bad.sum())
             nan_pixel[pix[bad]] = True
-            near.update(pix[hit], slot[hit], sqd[hit])
+            near.update(pix[hit], slot[hit], sqd[hit], sol.t[hit])
         if progress is not None:
             progress((done + 1) / len(blocks))
     st.skipped += n_pix * len(shapes) - st.tests
-    return near
+    return near, tables, S_shape
 
 
 def _shade(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, lights: list[Light], hp: np.ndarray,
@@ -170,6 +212,10 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
         if light.kind == POINT:
             apex = _f64(light.location)[0]
             dirs = _f64(direction)[tiles.order]
+    per_shape = None
+    if light.kind != POINT:  # one direction for every shadow ray: its normal-space terms per shape
+        _, D_shape = to_object(ar, shapes, None, direction)
+        per_shape = D_shape, direction_term(ar, shapes, D_shape)
     for sel in shape_blocks(len(shapes), len(tiles)):
         if not options.cull:
             keep = np.ones((len(tiles), len(sel)), bool)
@@ -181,8 +227,13 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
             other = slot != own[pos]
             pos, slot = pos[other], slot[other]
             s = shapes.take(slot)
-            S, D = to_object(ar, s, _take(origin, pos), _take(direction, pos))
-            sol = solve(ar, s, S, D, origin_term(ar, s, S), tmin, tmax)
+            if per_shape is None:
+                S, D = to_object(ar, s, _take(origin, pos), _take(direction, pos))
+                a2 = None
+            else:
+                S, _ = to_object(ar, s, _take(origin, pos), None)
+                D, a2 = _take(per_shape[0], slot), per_shape[1][slot]
+            sol = solve(ar, s, S, D, origin_term(ar, s, S), tmin, tmax, a2)
             st.tests += len(pos)
             st.nan_tests += int(sol.bad.sum())
             nan_pixel[pix[pos[sol.bad]]] = True

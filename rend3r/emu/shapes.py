@@ -80,7 +80,14 @@ def to_object(ar: Arith, s: Shapes, point: Vec | None, direction: Vec | None) ->
     return S, D
 
 
-def _zterm(s: Shapes, p: np.ndarray) -> np.ndarray:
+@dataclass(frozen=True)
+class Form:
+    """Just the normal form of shapes (how the z term enters), for pair batches."""
+
+    zsign: np.ndarray
+
+
+def _zterm(s: Shapes | Form, p: np.ndarray) -> np.ndarray:
     """The z product as the shape type uses it: kept, dropped (0) or negated."""
     with np.errstate(invalid="ignore"):
         return np.where(s.zsign == 0, np.zeros((), p.dtype), p * s.zsign)
@@ -116,11 +123,22 @@ def _finite(*arrays: np.ndarray) -> np.ndarray:
     return ok
 
 
-def solve(ar: Arith, s: Shapes, S: Vec, D: Vec, c2: np.ndarray, tmin: np.ndarray, tmax: np.ndarray) -> Solution:
-    """The quadratic a2/2 t^2 + b t + c2/2 = 0, nearest root t >= tmin (and > 0), t <= tmax."""
+def direction_term(ar: Arith, s: Shapes | Form, D: Vec) -> np.ndarray:
+    """a2 = 2*((Dx^2 + Dy^2) + z term): depends on the direction only."""
     dd = ar.add(ar.add(ar.mul(D[0], D[0]), ar.mul(D[1], D[1])), _zterm(s, ar.mul(D[2], D[2])))
+    return ar.add(dd, dd)
+
+
+def solve(ar: Arith, s: Shapes | Form, S: Vec, D: Vec, c2: np.ndarray, tmin: np.ndarray, tmax: np.ndarray,
+          a2: np.ndarray | None = None) -> Solution:
+    """The quadratic a2/2 t^2 + b t + c2/2 = 0, nearest root t >= tmin (and > 0), t <= tmax.
+
+    ``c2`` (origin term) and ``a2`` (direction term, computed here when None) may come
+    from tables shared by many pairs: the same operations on the same inputs.
+    """
+    if a2 is None:
+        a2 = direction_term(ar, s, D)
     ds = ar.add(ar.add(ar.mul(D[0], S[0]), ar.mul(D[1], S[1])), _zterm(s, ar.mul(D[2], S[2])))
-    a2 = ar.add(dd, dd)
     b = ar.add(ds, ds)
     disc = ar.sub(ar.mul(b, b), ar.mul(a2, c2))
     real = disc >= 0
@@ -134,6 +152,17 @@ def solve(ar: Arith, s: Shapes, S: Vec, D: Vec, c2: np.ndarray, tmin: np.ndarray
     t = np.where(ok1, t1, t2)
     hit = (ok1 | ok2) & (t <= tmax) & ~bad
     return Solution(hit, t, bad, a2, b, disc, root, t1, t2)
+
+
+def transform_classes(s: Shapes) -> tuple[np.ndarray, np.ndarray]:
+    """Shapes sharing rotation, inverse scales and type map a direction identically.
+
+    Returns (one representative position per class, class of each shape).
+    """
+    parts = [np.asarray(c, np.float64) for c in (*s.rot, *s.inv_scale)] + [s.kind.astype(np.float64)]
+    key = np.stack(parts, axis=1)
+    _, first, cls = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    return first, cls.reshape(-1)
 
 
 def surface(ar: Arith, s: Shapes, S: Vec, D: Vec, t: np.ndarray, origin: Vec, direction: Vec) -> tuple[Vec, Vec]:

@@ -96,6 +96,7 @@ _MIN_NORMAL_BITS = 0x38800000  # 2**-14 as float32 bits
 _FTZ_UP_BITS = 0x387FE000  # 2**-14 - 2**-25: the subnormal grid rounds it up to 2**-14
 _OVERFLOW_BITS = 0x477FF000  # 65520: rounds to infinity
 _INF_BITS = 0x7F800000
+_OVERFLOW_VALUE = np.float32(65520.0)
 
 
 def _round16_f32(a: np.ndarray, ftz: bool) -> np.ndarray:
@@ -106,16 +107,24 @@ def _round16_f32(a: np.ndarray, ftz: bool) -> np.ndarray:
     converting through numpy's float16 (tested exhaustively in the sign/exponent bands).
     """
     b = a.view(np.uint32)
-    ab = b & np.uint32(0x7FFFFFFF)
-    r = b + (np.uint32(0xFFF) + ((b >> np.uint32(13)) & np.uint32(1)))
+    r = np.right_shift(b, np.uint32(13))
+    r &= np.uint32(1)
+    r += np.uint32(0xFFF)
+    r += b
     r &= np.uint32(0xFFFFE000)
-    if ab.max() >= _OVERFLOW_BITS:
+    with np.errstate(invalid="ignore"):
+        hi, lo = a.max(), a.min()  # NaN propagates into both
+    if not (-_OVERFLOW_VALUE < lo and hi < _OVERFLOW_VALUE):
+        ab = b & np.uint32(0x7FFFFFFF)
         big = (ab >= _OVERFLOW_BITS) & (ab <= _INF_BITS)
         r[big] = (b[big] & _SIGN) | np.uint32(_INF_BITS)
         nan = ab > _INF_BITS
         r[nan] = b[nan]
-    small = (ab - np.uint32(1)) < np.uint32(_MIN_NORMAL_BITS - 1)  # nonzero, below float16 normals
-    if small.any():
+    mag = np.left_shift(r, np.uint32(1))  # sign dropped; zero wraps to the top below
+    mag -= np.uint32(1)
+    if mag.min() < np.uint32((_MIN_NORMAL_BITS << 1) - 1):  # some nonzero result below 2**-14
+        ab = b & np.uint32(0x7FFFFFFF)
+        small = (ab - np.uint32(1)) < np.uint32(_MIN_NORMAL_BITS - 1)
         if ftz:
             tiny = small & (ab < _FTZ_UP_BITS)
             np.copyto(r, b & _SIGN, where=tiny)
@@ -123,8 +132,8 @@ def _round16_f32(a: np.ndarray, ftz: bool) -> np.ndarray:
             if up.any():
                 r[up] = (b[up] & _SIGN) | np.uint32(_MIN_NORMAL_BITS)
         else:
-            mag = np.abs(a[small]).astype(np.float16).astype(np.float32)
-            r[small] = mag.view(np.uint32) | (b[small] & _SIGN)
+            m16 = np.abs(a[small]).astype(np.float16).astype(np.float32)
+            r[small] = m16.view(np.uint32) | (b[small] & _SIGN)
     return r.view(np.float32)
 
 

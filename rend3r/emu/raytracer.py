@@ -87,7 +87,7 @@ def render_frame(
             row = cls[slot] * n + hp
             Dh = (tab[0][row], tab[1][row], tab[2][row])
         point, normal = surface(ar, s, _take(S_shape, slot), Dh, near.t[hp], rays.origin, D)
-        color, bad = _shade(ar, options, shapes, bounds, lights, hp, slot, point, normal, st, nan_pixel)
+        color, bad = shade_hits(ar, options, shapes, bounds, lights, hp, slot, point, normal, st, nan_pixel)
         nan_pixel[hp[bad]] = True
         hp, slot = hp[~bad], slot[~bad]
         rgb[hp] = color[~bad]
@@ -164,28 +164,46 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
     return near, tables, S_shape
 
 
-def _shade(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, lights: list[Light], hp: np.ndarray,
-           slot: np.ndarray, point: Vec, normal: Vec, st: FrameStats, nan_pixel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """RGB565 per hit pixel and a mask of pixels whose shading met NaN or infinity."""
+#: Receives (stage name, values per shaded point) during shading (``docs/trace.md``).
+Recorder = Callable[[str, np.ndarray], None]
+
+
+def shade_hits(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, lights: list[Light], hp: np.ndarray,
+               slot: np.ndarray, point: Vec, normal: Vec, st: FrameStats, nan_pixel: np.ndarray,
+               record: Recorder | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """RGB565 per hit pixel and a mask of pixels whose shading met NaN or infinity.
+
+    ``hp`` are the pixels, ``slot`` their shapes' positions, ``point``/``normal`` the world
+    hit points and normals; ``record`` sees every lighting stage's values.
+    """
     base = shapes.color[slot]
     bad = ~(np.isfinite(point[0]) & np.isfinite(point[1]) & np.isfinite(point[2]))
     if not lights:
         return base, bad
+    rec = record if record is not None else (lambda stage, values: None)
     channels = np.stack([base >> 11, (base >> 5) & 0x3F, base & 0x1F], axis=1).astype(np.float64)
     acc = np.zeros_like(channels)
     nn = ar.sqrt(dot(ar, normal, normal))
     for light in lights:
+        k = f"L{light.index}"
         if light.kind == POINT:
             l_vec = sub3(ar, light.location, point)
         else:
             l_vec = tuple(ar.neg(c) for c in light.forward)
-        cos = ar.div(dot(ar, normal, l_vec), ar.mul(nn, ar.sqrt(dot(ar, l_vec, l_vec))))
+        n_dot_l = dot(ar, normal, l_vec)
+        l_len = ar.sqrt(dot(ar, l_vec, l_vec))
+        denom = ar.mul(nn, l_len)
+        cos = ar.div(n_dot_l, denom)
         f = ar.mul(cos, light.intensity)
+        for stage, v in (("l.x", l_vec[0]), ("l.y", l_vec[1]), ("l.z", l_vec[2]), ("n_dot_l", n_dot_l),
+                         ("n_len", nn), ("l_len", l_len), ("denom", denom), ("cos", cos), ("f", f)):
+            rec(f"{k}.{stage}", v)
         finite = np.isfinite(cos) & np.isfinite(f)
         bad |= ~finite
         lit = np.nonzero(finite & ~bad & (cos > 0))[0]
         blocked = _shadowed(ar, options, shapes, bounds, light, _take(point, lit), _take(l_vec, lit),
                             hp[lit], slot[lit], st, nan_pixel)
+        rec(f"{k}.shadow", blocked.astype(np.int64))
         lit = lit[~blocked]
         lc = light.color
         scale = np.array([(lc >> 11) / 31.0, ((lc >> 5) & 0x3F) / 63.0, (lc & 0x1F) / 31.0])

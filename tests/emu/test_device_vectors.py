@@ -79,3 +79,28 @@ def test_rendered_pixels_of_the_worked_scene(cull):
     assert frame.depth[188, 252] == pytest.approx(np.sqrt(float(np.float16(1.0185546875))), rel=1e-6)
     assert frame.provenance[188, 252] == 0 and frame.provenance[0, 0] == -1
     assert stats.nan_rays == 0
+
+
+def test_shading_stages_are_recorded_with_the_device_intensity():
+    from rend3r.emu.cull import shape_bounds
+    from rend3r.emu.lights import lights_from_scene
+    from rend3r.emu.raytracer import shade_hits
+    from rend3r.emu.stats import FrameStats
+
+    ar = make_arith("fp16", "ftz")
+    scene = _scene()
+    rays = camera_rays(scene, DEVICE, ar)
+    shapes = shapes_from_scene(scene, ar)
+    p = 188 * DEVICE.width + 252
+    D = tuple(d[p : p + 1] for d in rays.direction)
+    S, Dh = to_object(ar, shapes, rays.origin, D)
+    sol = solve(ar, shapes, S, Dh, origin_term(ar, shapes, S), rays.tmin, rays.tmax)
+    point, normal = surface(ar, shapes, S, Dh, sol.t, rays.origin, D)
+    seen = {}
+    rgb, bad = shade_hits(ar, DEVICE, shapes, shape_bounds(shapes), lights_from_scene(scene, ar), np.array([p]),
+                          np.array([0]), point, normal, FrameStats(), np.zeros(DEVICE.pixels, bool),
+                          record=lambda stage, v: seen.setdefault(stage, np.asarray(v).copy()))
+    assert list(seen) == [f"L0.{s}" for s in ("l.x", "l.y", "l.z", "n_dot_l", "n_len", "l_len", "denom", "cos", "f",
+                                              "shadow")]
+    assert _bits(seen["L0.cos"]) == 0x2E22 and seen["L0.shadow"].tolist() == [0]
+    assert not bad[0] and rgb[0] == (3 << 11) | (6 << 5) | 3

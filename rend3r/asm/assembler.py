@@ -12,12 +12,13 @@ import difflib
 import os
 import re
 from dataclasses import dataclass, field
+from fractions import Fraction
 from pathlib import Path
 from typing import Iterable
 
 from ..errors import Rend3rError
 from ..isa.encoding import CameraSet, FrameOp, LightSet, ShapeSet, encode
-from ..isa.float16 import round_literal, shortest_repr
+from ..isa.float16 import Rounded, round_literal, shortest_repr
 from ..isa.tables import (
     F_MNEMONICS,
     LIGHT_INDEX_LIMIT,
@@ -31,7 +32,7 @@ from ..isa.tables import (
 )
 from ..isa.targets import TARGETS, Target
 from .diagnostics import ERROR, WARNING, Diagnostic, format_all
-from .expressions import POISON, EvalError, Value, evaluate
+from .expressions import POISON, EvalError, Value, evaluate, fold
 from .fastpath import fast_line
 from .parser import Assignment, Directive, Instruction, Operand, Ref, Statement, Str, SyntaxProblem, parse_line
 from .program import Emitted, Program, SourceLoc
@@ -104,6 +105,15 @@ class _Rept:
     body: list = field(default_factory=list)
 
 
+def _folded(stmt: Statement) -> Statement:
+    """The statement with its constant arithmetic done (see :func:`.expressions.fold`)."""
+    if isinstance(stmt, Instruction):
+        return Instruction(stmt.mnemonic, stmt.col, stmt.end, tuple(fold(o) for o in stmt.operands))
+    if isinstance(stmt, Assignment):
+        return Assignment(stmt.name, stmt.col, stmt.end, fold(stmt.expr))
+    return Directive(stmt.name, stmt.col, stmt.end, tuple(fold(a) for a in stmt.args))
+
+
 def resolve_target(target: str | Target | None) -> Target | None:
     """A Target from its name (see :data:`rend3r.isa.targets.TARGETS`)."""
     if target is None or isinstance(target, Target):
@@ -135,6 +145,7 @@ class Assembler:
         self.scopes: list[list[str]] = []  # constants defined in each running .rept iteration
         self.include_stack: list[Path] = []
         self.statements = 0
+        self.rounded: dict[tuple[int | Fraction, bool], Rounded] = {}  # round_literal cache
         # where the statement being run comes from: file, line, text, context
         self.where: tuple[str, int, str, tuple[str, ...]] = ("", 0, "", ())
 
@@ -208,7 +219,7 @@ class Assembler:
                     body = None
                     self.run_rept(done, context)
             elif body is not None:
-                body.append(_Stmt(stmt, file, lineno, line))
+                body.append(_Stmt(_folded(stmt), file, lineno, line))
             else:
                 self.run_statement(_Stmt(stmt, file, lineno, line), context)
         for node in open_repts:
@@ -449,7 +460,10 @@ class Assembler:
                 node.col,
                 node.end,
             )
-        r = round_literal(v.number, negative=v.negative_zero)
+        key = (v.number, v.negative_zero)
+        r = self.rounded.get(key)
+        if r is None:
+            r = self.rounded[key] = round_literal(v.number, negative=v.negative_zero)
         if r.overflow:
             self.error(f"{src} overflows float16 (magnitude must be below 65520; largest finite is 65504)",
                        node.col, node.end)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Mapping
 
-from .parser import BinOp, Expr, Neg, Num, Ref, Str
+from .parser import BinOp, Expr, Neg, Num, Operand, Ref, Str
 
 
 @dataclass(frozen=True, slots=True)
@@ -28,7 +28,7 @@ class Value:
 
     @property
     def is_integer(self) -> bool:
-        return self.raw is None and isinstance(self.number, int)
+        return self.raw is None and type(self.number) is int
 
     @property
     def sign_negative(self) -> bool:
@@ -50,12 +50,6 @@ class EvalError(Exception):
         self.end = end
 
 
-def _normal(x: int | Fraction) -> int | Fraction:
-    if isinstance(x, Fraction) and x.denominator == 1:
-        return x.numerator
-    return x
-
-
 def evaluate(node: Expr | Str, env: Mapping[str, Value]) -> Value:
     """The exact value of ``node``; names are looked up in ``env``."""
     cls = type(node)
@@ -64,7 +58,7 @@ def evaluate(node: Expr | Str, env: Mapping[str, Value]) -> Value:
             raise EvalError(node.error, node.col, node.end)
         if node.kind == "raw":
             return Value(raw=node.value)
-        return Value(node.value, hex_literal=node.kind == "hex")
+        return Value(node.value, negative_zero=node.negative_zero, hex_literal=node.kind == "hex")
     if cls is Ref:
         try:
             value = env[node.name]
@@ -90,24 +84,59 @@ def _number(v: Value, node: Expr) -> Value:
 
 
 def _binop(node: BinOp, a: Value, b: Value) -> Value:
-    op = node.op
-    if op == "+" or op == "-":
-        y = b.number if op == "+" else -b.number
-        y_neg = b.sign_negative if op == "+" else not b.sign_negative
-        r = a.number + y
-        # IEEE: an exact zero sum is -0 only when both addends are negative zeros.
-        return Value(_normal(r), negative_zero=r == 0 and a.number == 0 and y == 0 and a.sign_negative and y_neg)
-    sign = a.sign_negative != b.sign_negative
-    if op == "*":
-        r = a.number * b.number
-        return Value(_normal(r), negative_zero=r == 0 and sign)
-    if b.number == 0:
+    op, x, y = node.op, a.number, b.number
+    if op == "+":
+        r = x + y
+    elif op == "-":
+        r = x - y
+    elif op == "*":
+        r = x * y
+    elif y == 0:
         raise EvalError("division by zero", node.right.col, node.right.end)
-    r = Fraction(a.number, b.number)
-    return Value(_normal(r), negative_zero=r == 0 and sign)
+    elif type(x) is int and type(y) is int:
+        q, rem = divmod(x, y)
+        r = q if rem == 0 else Fraction(x, y)
+    else:
+        r = x / y
+    if r:
+        return Value(r.numerator if type(r) is Fraction and r.denominator == 1 else r)
+    # An exact zero: its sign as IEEE 754 gives it. A sum is -0 only when both addends
+    # are negative zeros; a product or quotient is -0 when the signs differ.
+    if op == "+" or op == "-":
+        y_negative = b.negative_zero if op == "+" else not b.negative_zero
+        return Value(0, negative_zero=x == 0 and y == 0 and a.negative_zero and y_negative)
+    return Value(0, negative_zero=a.sign_negative != b.sign_negative)
+
+
+def fold(node: Operand) -> Operand:
+    """``node`` with every arithmetic on literals done once, ahead of time (used for
+    ``.rept`` bodies, which run many times). Whatever would fail is left as written, so
+    the error is still reported where and when it happens."""
+    cls = type(node)
+    if cls is Neg:
+        inner = fold(node.operand)
+        node = Neg(inner, node.col, node.end)
+        if _foldable(inner):
+            v = evaluate(node, {})
+            return Num(v.number, "dec", node.col, node.end, negative_zero=v.negative_zero)
+        return node
+    if cls is BinOp:
+        node = BinOp(node.op, fold(node.left), fold(node.right), node.col, node.end)
+        if _foldable(node.left) and _foldable(node.right):
+            try:
+                v = evaluate(node, {})
+            except EvalError:
+                return node
+            return Num(v.number, "dec", node.col, node.end, negative_zero=v.negative_zero)
+    return node
+
+
+def _foldable(node: Operand) -> bool:
+    return type(node) is Num and not node.error and node.kind != "raw"
 
 
 def _undefined(name: str, env: Mapping[str, Value]) -> str:
-    close = difflib.get_close_matches(name, list(env), n=1)
+    same_case = [n for n in env if n.lower() == name.lower()]
+    close = same_case or difflib.get_close_matches(name, list(env), n=1)
     hint = f"; did you mean '{close[0]}'?" if close else ""
     return f"undefined name '{name}'{hint}"

@@ -25,14 +25,15 @@ MAX_DIGITS = 1000
 
 @dataclass(frozen=True, slots=True)
 class Num:
-    """A numeric literal. ``kind`` is dec, hex, bin or raw (raw: ``value`` is the bits);
-    ``error`` is set when the literal is malformed."""
+    """A numeric literal (or a folded constant expression, kind dec). ``kind`` is dec,
+    hex, bin or raw (raw: ``value`` is the bits); ``error`` is set when it is malformed."""
 
     value: int | Fraction
     kind: str
     col: int
     end: int
     error: str = ""
+    negative_zero: bool = False  # a folded constant expression that came out as -0
 
 
 @dataclass(frozen=True, slots=True)

@@ -87,7 +87,9 @@ def _level_nodes(codes: np.ndarray, depth: int) -> list[tuple[np.ndarray, np.nda
     levels = []
     child_codes = codes
     for _ in range(depth):
-        keys, first = np.unique(child_codes >> 3, return_index=True)
+        parents = child_codes >> 3  # sorted, because child_codes are
+        first = np.flatnonzero(np.r_[True, parents[1:] != parents[:-1]])
+        keys = parents[first]
         bits = np.left_shift(1, child_codes & 7)
         valid = np.bitwise_or.reduceat(bits, first) if len(first) else np.zeros(0, np.int64)
         levels.append((keys, valid.astype(np.int64), first))
@@ -112,7 +114,8 @@ def build_octree(coords: np.ndarray, depth: int, ptr_bits: int = DEFAULT_PTR_BIT
         raise Rend3rError("no voxels to build an octree from")
     if coords.min() < 0 or coords.max() >= (1 << depth):
         raise Rend3rError(f"voxel coordinates outside [0, {1 << depth})")
-    codes = np.unique(morton_encode(coords, depth))
+    codes = np.sort(morton_encode(coords, depth))
+    codes = codes[np.r_[True, codes[1:] != codes[:-1]]]
     levels = _level_nodes(codes, depth)
     n_levels = len(levels)
     counts = [len(k) for k, _, _ in levels]
@@ -121,15 +124,18 @@ def build_octree(coords: np.ndarray, depth: int, ptr_bits: int = DEFAULT_PTR_BIT
     rank = []
     for lvl in range(1, n_levels):
         keys = levels[lvl][0]
-        par = np.searchsorted(levels[lvl - 1][0], keys >> 3)
+        starts = levels[lvl - 1][2]  # first child of each parent (children sorted by parent)
+        flags = np.zeros(len(keys), dtype=np.int64)
+        flags[starts] = 1
+        par = np.cumsum(flags) - 1
         parent.append(par)
-        starts = levels[lvl - 1][2]
         rank.append(np.arange(len(keys)) - starts[par])
     table_len = [np.bincount(parent[lvl - 1], minlength=counts[lvl - 1]) for lvl in range(1, n_levels)]
     max_ptr = (1 << ptr_bits) - 1
     far = [np.zeros(c, dtype=bool) for c in counts]
     while True:
-        addr, region, table_start, slots_before = _layout(counts, parent, rank, table_len, far)
+        addr, region, table_start, slots_before = _layout(counts, parent, rank, table_len, far,
+                                                          [lv[2] for lv in levels])
         changed = False
         for lvl in range(n_levels - 1):
             table_addr = region[lvl + 1] + table_start[lvl + 1]
@@ -170,7 +176,7 @@ def _region_size(counts: list[int], far: list[np.ndarray], lvl: int) -> int:
 
 
 def _layout(counts: list[int], parent: list[np.ndarray], rank: list[np.ndarray],
-            table_len: list[np.ndarray], far: list[np.ndarray]):
+            table_len: list[np.ndarray], far: list[np.ndarray], first_child: list[np.ndarray]):
     """Node addresses, region starts, table starts and far-slot ranks per level."""
     n_levels = len(counts)
     region = np.zeros(n_levels, dtype=np.int64)
@@ -188,7 +194,7 @@ def _layout(counts: list[int], parent: list[np.ndarray], rank: list[np.ndarray],
         addr.append(region[lvl] + start[par] + rank[lvl - 1])
         # number of far nodes before this one in the same table
         cum_far = np.cumsum(far[lvl]) - far[lvl]
-        first_in_table = cum_far[np.searchsorted(par, np.arange(n_par))[par]] if len(par) else cum_far
+        first_in_table = cum_far[first_child[lvl - 1][par]]
         slots_before.append(cum_far - first_in_table)
     return addr, region, table_start, slots_before
 

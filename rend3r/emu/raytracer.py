@@ -7,6 +7,8 @@ cannot change a pixel. Colour arithmetic (after the float16 datapath): see
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from time import perf_counter
 from typing import Callable
 
@@ -35,6 +37,24 @@ def _f64(v: Vec) -> np.ndarray:
 
 def _take(v: Vec, idx: np.ndarray) -> Vec:
     return tuple(c[idx] if np.ndim(c) else c for c in v)
+
+
+_WORKERS = min(4, os.cpu_count() or 1)
+
+
+def _parallel(fn, items):
+    """fn over items on worker threads (numpy releases the GIL), results in order."""
+    if _WORKERS < 2:
+        yield from map(fn, items)
+        return
+    with ThreadPoolExecutor(_WORKERS) as pool:
+        pending = []
+        for item in items:
+            pending.append(pool.submit(fn, item))
+            if len(pending) > 2 * _WORKERS:
+                yield pending.pop(0).result()
+        for f in pending:
+            yield f.result()
 
 
 class _Nearest:
@@ -140,7 +160,8 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
     blocks = list(shape_blocks(len(shapes), len(tiles)))
     for done, sel in enumerate(blocks):
         keep = cone_keep(tiles, apex, dirs, None, bounds, sel, fp16) if options.cull else np.ones((len(tiles), len(sel)), bool)
-        for pix, slot in pairs(tiles, keep, sel):
+        def test(batch):
+            pix, slot = batch
             if tables is None:
                 s = shapes.take(slot)
                 _, Dh = to_object(ar, s, None, _take(rays.direction, pix))
@@ -153,11 +174,14 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
             sol = solve(ar, s, _take(S_shape, slot), Dh, c2_shape[slot], rays.tmin, rays.tmax, a2)
             sqd = squared_distance(ar, dd[pix], sol.t)
             bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
-            hit = sol.hit & ~bad
+            return pix, slot, sqd, sol.t, sol.hit & ~bad, bad
+
+        # batches are independent; the nearest-hit merge is order-free (min, ties to index)
+        for pix, slot, sqd, t, hit, bad in _parallel(test, pairs(tiles, keep, sel)):
             st.tests += len(pix)
             st.nan_tests += int(bad.sum())
             nan_pixel[pix[bad]] = True
-            near.update(pix[hit], slot[hit], sqd[hit], sol.t[hit])
+            near.update(pix[hit], slot[hit], sqd[hit], t[hit])
         if progress is not None:
             progress((done + 1) / len(blocks))
     st.skipped += n_pix * len(shapes) - st.tests
@@ -241,7 +265,8 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
             keep = cone_keep(tiles, apex, dirs, org, bounds, sel, fp16)
         else:
             keep = parallel_keep(tiles, _f64(direction)[0], org, bounds, sel, fp16)
-        for pos, slot in pairs(tiles, keep, sel):
+        def test(batch):
+            pos, slot = batch
             other = slot != own[pos]
             pos, slot = pos[other], slot[other]
             s = shapes.take(slot)
@@ -252,9 +277,12 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
                 S, _ = to_object(ar, s, _take(origin, pos), None)
                 D, a2 = _take(per_shape[0], slot), per_shape[1][slot]
             sol = solve(ar, s, S, D, origin_term(ar, s, S), tmin, tmax, a2)
+            return pos, sol.hit, sol.bad
+
+        for pos, hit, bad in _parallel(test, pairs(tiles, keep, sel)):
             st.tests += len(pos)
-            st.nan_tests += int(sol.bad.sum())
-            nan_pixel[pix[pos[sol.bad]]] = True
-            blocked[pos[sol.hit]] = True
+            st.nan_tests += int(bad.sum())
+            nan_pixel[pix[pos[bad]]] = True
+            blocked[pos[hit]] = True
     st.skipped += n * (len(shapes) - 1) - (st.tests - before)
     return blocked

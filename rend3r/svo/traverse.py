@@ -37,6 +37,8 @@ from .fixed import ONE, clamp_direction, to_fixed
 from .octree import Octree, child_table, morton_decode, popcount8
 
 _AXIS_BIT = (4, 2, 1)
+#: _SIDE[i, a]: child index i is on the high side of axis a's middle plane
+_SIDE = ((np.arange(8)[:, None] >> np.array([2, 1, 0])) & 1).astype(bool)
 
 
 @dataclass
@@ -189,10 +191,10 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
         st["steps"] += alive
         tsum = t0 + t1
         tm = tsum >> 1 if fixed else tsum * 0.5
-        bits = ((idx[:, None] >> np.array([2, 1, 0])) & 1).astype(bool)
+        bits = _SIDE[idx]
         t0c = np.where(bits, tm, t0)
         t1c = np.where(bits, t1, tm)
-        texit = t1c.min(1)
+        texit = np.minimum(np.minimum(t1c[:, 0], t1c[:, 1]), t1c[:, 2])
         cidx = idx ^ st["dmask"]
         valid = (word >> (8 + cidx)) & 1
         leaf = (word >> cidx) & 1
@@ -205,7 +207,7 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
         if hit.any():
             h = np.flatnonzero(hit)
             tc = t0c[h]
-            enter = tc.max(1)
+            enter = np.maximum(np.maximum(tc[:, 0], tc[:, 1]), tc[:, 2])
             axis = np.where(tc[:, 0] == enter, 0, np.where(tc[:, 1] == enter, 1, 2))
             r = st["rid"][h]
             tf = enter / ONE if fixed else enter
@@ -288,8 +290,8 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
                     meta = st["s_meta"][pop, top]
                     pidx = meta & 7
                     if fixed:
-                        cb = ((pidx[:, None] >> np.array([2, 1, 0])) & 1).astype(bool)
-                        tbit = (meta[:, None] >> np.array([5, 4, 3])) & 1
+                        cb = _SIDE[pidx]
+                        tbit = _SIDE[(meta >> 3) & 7].astype(t0.dtype)
                         c0, c1 = t0[pop], t1[pop]
                         tmv = np.where(cb, c0, c1)
                         tpass = np.where(cb, c1, c0)

@@ -20,6 +20,7 @@ import time
 
 from rend3r.asm.assembler import assemble_source
 from rend3r.asm.fastpath import clear_cache
+from rend3r.asm.parser import clear_operand_cache
 from rend3r.isa.tables import PROPERTIES, Table, ValueType
 
 TARGET_LINES_PER_S = 50_000
@@ -94,6 +95,7 @@ def _rate(text: str, runs: int, fast: bool) -> tuple[float, float]:
     wall, cpu = [], []
     for _ in range(runs):
         clear_cache()
+        clear_operand_cache()
         t0, c0 = time.perf_counter(), time.process_time()
         result = assemble_source(text, "bench.asm", fast=fast)
         wall.append(time.perf_counter() - t0)

@@ -34,7 +34,18 @@ from ..isa.targets import TARGETS, Target
 from .diagnostics import ERROR, WARNING, Diagnostic, format_all
 from .expressions import POISON, EvalError, Value, evaluate, fold
 from .fastpath import fast_line
-from .parser import Assignment, Directive, Instruction, Operand, Ref, Statement, Str, SyntaxProblem, parse_line
+from .parser import (
+    Assignment,
+    Directive,
+    Instruction,
+    Operand,
+    Ref,
+    Statement,
+    Str,
+    SyntaxProblem,
+    parse_instruction,
+    parse_line,
+)
 from .program import Emitted, Program, SourceLoc
 
 #: Statements run (after .rept expansion) before the assembler gives up on a program.
@@ -192,11 +203,13 @@ class Assembler:
                     body.append(_Fixed(mnemonic, words, loc, line))
                 continue
             self.where = (file, lineno, line, context)
-            try:
-                stmt = parse_line(line)
-            except SyntaxProblem as p:
-                self.error(p.message, p.col, p.end)
-                continue
+            stmt = parse_instruction(line) if fast else None
+            if stmt is None:
+                try:
+                    stmt = parse_line(line)
+                except SyntaxProblem as p:
+                    self.error(p.message, p.col, p.end)
+                    continue
             if stmt is None:
                 continue
             kind = stmt.name.lower() if isinstance(stmt, Directive) else ""

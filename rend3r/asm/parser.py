@@ -153,6 +153,9 @@ class _Builder(Transformer):
     def start(self, children: list) -> Statement | None:
         return children[0] if children else None
 
+    def operand(self, children: list) -> Expr:
+        return children[0]
+
     def instruction(self, children: list) -> Instruction:
         name = children[0]
         return Instruction(str(name), name.column, name.end_column, tuple(children[1:]))
@@ -205,7 +208,8 @@ def _respan(node: Expr, col: int, end: int) -> Expr:
 @lru_cache(maxsize=1)
 def _parser() -> Lark:
     grammar = (Path(__file__).with_name("grammar.lark")).read_text(encoding="utf-8")
-    return Lark(grammar, parser="lalr", lexer="contextual", transformer=_Builder(), maybe_placeholders=False)
+    return Lark(grammar, parser="lalr", lexer="contextual", transformer=_Builder(), maybe_placeholders=False,
+                start=["start", "operand"])
 
 
 _TOKEN_WORDS = {
@@ -241,7 +245,7 @@ def parse_line(text: str) -> Statement | None:
     Raises SyntaxProblem with a column span for anything the grammar rejects.
     """
     try:
-        return _parser().parse(text)
+        return _parser().parse(text, start="start")
     except UnexpectedCharacters as exc:
         ch = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
         shown = repr(ch) if ch.isprintable() else f"U+{ord(ch):04X}"
@@ -257,3 +261,70 @@ def parse_line(text: str) -> Statement | None:
             raise SyntaxProblem(f"unexpected end of line, expected {expected}", col, col + 1) from None
         what = f"'{tok}'"
         raise SyntaxProblem(f"unexpected {what}, expected {expected}", tok.column, tok.end_column) from None
+
+
+_WS = "[ \t\f\v\r]"
+# mnemonic, whitespace, operand text (no string, no comment), optional comment
+_INSTRUCTION = re.compile(
+    rf"{_WS}*([A-Za-z_][A-Za-z0-9_]*){_WS}+((?:[^;/\"]|/(?!/))*?){_WS}*(?:(?://|;).*)?", re.ASCII
+)
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*", re.ASCII)
+#: operand text -> its tree with columns counted from the operand's first character
+_OPERANDS: dict[str, Expr | None] = {}
+_OPERAND_CACHE_LIMIT = 1 << 16
+
+
+def clear_operand_cache() -> None:
+    """Forget parsed operands (benchmarks measure a cold cache)."""
+    _OPERANDS.clear()
+
+
+def parse_instruction(text: str) -> Instruction | None:
+    """Parse an instruction line operand by operand, or None when the line is anything
+    else or does not parse (then :func:`parse_line` gives the verdict and its message).
+
+    Each operand is parsed with the grammar's ``operand`` start symbol and cached by its
+    text, so the repeated expressions of real programs are parsed once. The result is the
+    tree :func:`parse_line` builds for the same line.
+    """
+    m = _INSTRUCTION.fullmatch(text)
+    if m is None or not m.group(2):
+        return None
+    operands = []
+    pos = m.start(2)
+    for piece in m.group(2).split(","):
+        stripped = piece.strip(" \t\f\v\r")
+        if not stripped:
+            return None
+        col = pos + len(piece) - len(piece.lstrip(" \t\f\v\r")) + 1
+        pos += len(piece) + 1
+        if _NAME.fullmatch(stripped):
+            operands.append(Ref(stripped, col, col + len(stripped)))
+            continue
+        node = _OPERANDS.get(stripped, False)
+        if node is False:
+            try:
+                node = _parser().parse(stripped, start="operand")
+            except (UnexpectedCharacters, UnexpectedToken):
+                node = None
+            if len(_OPERANDS) >= _OPERAND_CACHE_LIMIT:
+                _OPERANDS.clear()
+            _OPERANDS[stripped] = node
+        if node is None:
+            return None
+        operands.append(_shift(node, col - 1))
+    name = m.group(1)
+    col = m.start(1) + 1
+    return Instruction(name, col, col + len(name), tuple(operands))
+
+
+def _shift(node: Expr, delta: int) -> Expr:
+    """The same tree, ``delta`` columns to the right."""
+    cls = type(node)
+    if cls is Num:
+        return Num(node.value, node.kind, node.col + delta, node.end + delta, node.error, node.negative_zero)
+    if cls is Ref:
+        return Ref(node.name, node.col + delta, node.end + delta)
+    if cls is Neg:
+        return Neg(_shift(node.operand, delta), node.col + delta, node.end + delta)
+    return BinOp(node.op, _shift(node.left, delta), _shift(node.right, delta), node.col + delta, node.end + delta)

@@ -115,6 +115,9 @@ values = st.one_of(
     st.integers(0, 0xFFFF).map(lambda v: f"0h{v:x}"),
     st.sampled_from(["-0", "0", "65504", "65519.99", "65520", "2049", "2051", "1.00048828125", "5.96e-8",
                      "2.98023223876953125e-8", "1e-7", ".5", "1.", "1E+3", "0X1F", "0B101", "0H7C00", "0x3c00"]),
+    # expressions take the operand-by-operand parser (parse_instruction)
+    st.sampled_from(["1 + 2", "-(3) * 0.5", "K * 2", "(1", "1)", "0x1e+1", "1__0 * 2", "6 / 3", "1 / 0", "-0 * 1",
+                     "0h3c00 + 1", "(1 + 2) * (3 - 4) / 5", "a b", "1 // 2", "1 / 2", "@"]),
 )
 
 
@@ -135,7 +138,7 @@ def simple_lines(draw) -> str:
         else:
             idx = draw(st.sampled_from([0, 1, 7, 8, 524287, 524288, 3000000]))
             ops = [str(idx), names[0], names[1], draw(values), draw(values)]
-    comment = draw(st.sampled_from(["", " ; c", "// c", "\t"]))
+    comment = draw(st.sampled_from(["", " ; c", "// c", "\t", " ; a, b", ' "s"']))
     lead = draw(st.sampled_from(["", "  ", "\t"]))
     return lead + case(mn) + (" " + sep.join(ops) if ops else "") + comment
 

@@ -4,14 +4,16 @@
 ; Shows:  a cylinder of radius 1 whose axis runs parallel to the view axis, 1.5 below
 ;         and right of it, so it recedes to the vanishing point at the screen centre: rays
 ;         near that point run almost parallel to the axis (the quadratic's a tends to 0)
-;         and meet the surface farther and farther away. A slim double cone (radius
-;         a quarter of the height) has its apex at (-2, 1.5, -8), up and to the left. Light 0 travels
-;         exactly along the cylinder's axis, parallel to its surface (n.l = 0, adds
-;         nothing to the cylinder); light 1 is a point light between the two shapes.
+;         and meet the surface farther and farther away. A slim double cone (radius a
+;         quarter of the height) has its apex at (-2, 1.5, -8), up and to the left.
+;         Light 0 travels exactly along the cylinder's axis, parallel to its surface
+;         (n.l = 0, adds nothing to the cylinder); light 1 is a point light between
+;         the two shapes.
 ; Run:    rend3r emulate programs/fp16_grazing.asm -o fp16_grazing.png
 ; Look:   a lavender pipe running from the lower right corner into the centre; an
-;         orange hourglass pinched to a point at the upper left. In fp16 the pipe stops short of the
-;         vanishing point where its distance passes 256 (see fp16_distance.asm).
+;         orange hourglass pinched to a point at the upper left, its far nappe a disc
+;         around the centre. In fp16 a thin ring of that far nappe, more than 256 units
+;         away, is black (see fp16_distance.asm).
 ; frames: 1
 
 nr

@@ -10,8 +10,10 @@
 ;         distance overflows in float16).
 ; Run:    rend3r emulate programs/fp16_limits.asm -o fp16_limits.png
 ;         (compare --precision fp64 and --subnormals ieee)
-; Look:   fp16: a horizontal cyan bar across the screen and the shapes that float16 can
-;         represent; fp64 also draws the huge far sphere as a dim backdrop.
+; Look:   fp16: a red sphere (the zero quaternion reads as no rotation) above a
+;         horizontal cyan bar across the screen; the non-unit-quaternion sphere is lost
+;         too (|q|^2 = 4 scales its object coordinates until b*b overflows). fp64 also
+;         draws it, small and yellow, and the huge far sphere as a grey backdrop.
 ; frames: 1
 
 nr

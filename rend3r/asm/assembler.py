@@ -185,9 +185,9 @@ class Assembler:
         fast = self.fast
         limits = self.limits
         entries = self.entries
+        if "\r" in text:
+            text = text.replace("\r\n", "\n")
         for lineno, line in enumerate(text.split("\n"), 1):
-            if line.endswith("\r"):
-                line = line[:-1]
             hit = fast_line(line, limits) if fast else None
             if hit is not None:
                 if not hit:
@@ -195,7 +195,9 @@ class Assembler:
                 mnemonic, words, col = hit
                 loc = SourceLoc(file, lineno, col)
                 if body is None:
-                    self.count_statement()
+                    self.statements += 1
+                    if self.statements > MAX_STATEMENTS:
+                        self.too_large()
                     entries.append(Emitted(self.address, words, loc, line))
                     self.address += len(words)
                     self.mnemonics.add(mnemonic)
@@ -242,10 +244,13 @@ class Assembler:
     def count_statement(self) -> None:
         self.statements += 1
         if self.statements > MAX_STATEMENTS:
-            file, line, _, _ = self.where
-            self.where = (file, line, "", ())
-            self.error(f"program too large: more than {MAX_STATEMENTS} statements after .rept expansion")
-            raise _Abort
+            self.too_large()
+
+    def too_large(self) -> None:
+        file, line, _, _ = self.where
+        self.where = (file, line, "", ())
+        self.error(f"program too large: more than {MAX_STATEMENTS} statements after .rept expansion")
+        raise _Abort
 
     # -- running -----------------------------------------------------------------------
 

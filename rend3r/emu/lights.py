@@ -27,16 +27,22 @@ class Light:
     intensity: np.ndarray
 
 
-def lights_from_scene(scene: Scene, arith: Arith) -> list[Light]:
-    """Lights whose ``src`` low two bits say directional (1) or point (2), in index order."""
+def lights_from_scene(scene: Scene, arith: Arith, model: str = "spec") -> list[Light]:
+    """Lights whose ``src`` low two bits say directional (1) or point (2), in index order.
+
+    ``model="device"``: only light 0, always directional (whatever its ``src``), white at
+    intensity 1 (the device ignores colour and intensity).
+    """
     p = {n: prop_index(Table.LIGHT, n) for n in (
         "src", "xloc", "yloc", "zloc", "xfor", "yfor", "zfor", "col", "int")}
     out = []
-    for index in sorted(scene.lights):
-        props = scene.lights[index]
-        kind = props.get(p["src"], 0) & 3
+    for index in sorted(scene.lights) if model == "spec" else [0]:
+        props = scene.lights.get(index, {})
+        kind = props.get(p["src"], 0) & 3 if model == "spec" else DIRECTIONAL
         if kind not in (DIRECTIONAL, POINT):
             continue
+        if model != "spec":
+            props = {k: v for k, v in props.items() if k not in (p["col"], p["int"])}
         v = lambda n: arith.from_bits(props.get(p[n], 0))  # noqa: E731
         out.append(Light(
             index, kind, (v("xloc"), v("yloc"), v("zloc")), (v("xfor"), v("yfor"), v("zfor")),

@@ -12,7 +12,8 @@ from typing import Literal
 from .arith import Arith, Precision, make_arith
 
 Mode = Literal["raytrace", "raster"]
-DepthRule = Literal["zbuffer", "painter"]
+DepthRule = Literal["zbuffer", "painter", "index"]
+LightModel = Literal["spec", "device"]
 CameraModel = Literal["spec", "device"]
 
 
@@ -30,7 +31,16 @@ class EmuOptions:
     lr_target: int = 0  # address `lr` jumps to (the device jumps to 1)
     clear_on_nr: bool = True  # `nr` clears scene state and frame buffer (the device does not)
     cull: bool = True  # skip shape tests that provably cannot change a pixel
-    depth: DepthRule = "zbuffer"  # raster mode: hidden surfaces by z-buffer or painter's order
+    depth: DepthRule = "zbuffer"  # raster mode: z-buffer, painter's order, or index order (device)
+    light_model: LightModel = "spec"  # "device": light 0 only, directional, colour/intensity ignored
+    intensity_fixed: bool = False  # the device's 13-bit converter of the light factor
+    er_needs_zero: bool = False  # `er` halts only if the next word is zero too (device)
+    # Rasterizer switches (read by raster.py, see docs/raster.md and docs/device-profile.md)
+    raster_camera: Literal["spec", "device"] = "spec"
+    raster_shading: bool = True
+    raster_rules: Literal["spec", "device"] = "spec"
+    raster_column_offset: int = 0
+    raster_next_triangle: bool = False
 
     @property
     def arith(self) -> Arith:

@@ -76,7 +76,9 @@ def execute(
             scene.set_object(ins, table)
         elif isinstance(ins, FrameOp):
             if ins.func is Func.ER:
-                return Execution(count, executed, "er")
+                if not options.er_needs_zero or pc >= len(words) or words[pc] == 0:
+                    return Execution(count, executed, "er")
+                continue  # the device skips an er whose next word is not zero
             if ins.func is Func.NR:
                 if options.clear_on_nr:
                     scene.clear()

@@ -18,13 +18,14 @@ from .arith import Arith
 from .camera import camera_rays
 from .cull import Bounds, Tiles, cone_keep, make_tiles, pairs, parallel_keep, shape_blocks, shape_bounds
 from .frame import Frame
+from .lighting import Recorder, diffuse
 from .lights import POINT, Light, lights_from_scene
 from .options import EmuOptions
 from .scene import Scene
 from .shapes import (Form, Shapes, direction_term, origin_term, shapes_from_scene, solve, squared_distance, surface,
                      to_object, transform_classes)
 from .stats import FrameStats
-from .vec import Vec, dot, sub3
+from .vec import Vec, dot
 
 Progress = Callable[[float], None]
 _NONE = np.iinfo(np.int64).max
@@ -86,7 +87,7 @@ def render_frame(
     w, h, n_pix = options.width, options.height, options.pixels
     rays = camera_rays(scene, options, ar)
     shapes = shapes_from_scene(scene, ar)
-    lights = lights_from_scene(scene, ar)
+    lights = lights_from_scene(scene, ar, options.light_model)
     st = FrameStats(number=number, pixels=n_pix, shapes=len(shapes), lights=len(lights), rays=n_pix)
     rgb = np.full(n_pix, options.background, dtype=np.uint16)
     depth = np.full(n_pix, np.inf, dtype=np.float32)
@@ -188,52 +189,19 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
     return near, tables, S_shape
 
 
-#: Receives (stage name, values per shaded point) during shading (``docs/trace.md``).
-Recorder = Callable[[str, np.ndarray], None]
-
-
 def shade_hits(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, lights: list[Light], hp: np.ndarray,
                slot: np.ndarray, point: Vec, normal: Vec, st: FrameStats, nan_pixel: np.ndarray,
                record: Recorder | None = None) -> tuple[np.ndarray, np.ndarray]:
     """RGB565 per hit pixel and a mask of pixels whose shading met NaN or infinity.
 
     ``hp`` are the pixels, ``slot`` their shapes' positions, ``point``/``normal`` the world
-    hit points and normals; ``record`` sees every lighting stage's values.
+    hit points and normals. Lighting is :func:`.lighting.diffuse` (shared with the
+    rasterizer) with shadow rays as its occlusion test; ``record`` sees every stage.
     """
-    base = shapes.color[slot]
-    bad = ~(np.isfinite(point[0]) & np.isfinite(point[1]) & np.isfinite(point[2]))
-    if not lights:
-        return base, bad
-    rec = record if record is not None else (lambda stage, values: None)
-    channels = np.stack([base >> 11, (base >> 5) & 0x3F, base & 0x1F], axis=1).astype(np.float64)
-    acc = np.zeros_like(channels)
-    nn = ar.sqrt(dot(ar, normal, normal))
-    for light in lights:
-        k = f"L{light.index}"
-        if light.kind == POINT:
-            l_vec = sub3(ar, light.location, point)
-        else:
-            l_vec = tuple(ar.neg(c) for c in light.forward)
-        n_dot_l = dot(ar, normal, l_vec)
-        l_len = ar.sqrt(dot(ar, l_vec, l_vec))
-        denom = ar.mul(nn, l_len)
-        cos = ar.div(n_dot_l, denom)
-        f = ar.mul(cos, light.intensity)
-        for stage, v in (("l.x", l_vec[0]), ("l.y", l_vec[1]), ("l.z", l_vec[2]), ("n_dot_l", n_dot_l),
-                         ("n_len", nn), ("l_len", l_len), ("denom", denom), ("cos", cos), ("f", f)):
-            rec(f"{k}.{stage}", v)
-        finite = np.isfinite(cos) & np.isfinite(f)
-        bad |= ~finite
-        lit = np.nonzero(finite & ~bad & (cos > 0))[0]
-        blocked = _shadowed(ar, options, shapes, bounds, light, _take(point, lit), _take(l_vec, lit),
-                            hp[lit], slot[lit], st, nan_pixel)
-        rec(f"{k}.shadow", blocked.astype(np.int64))
-        lit = lit[~blocked]
-        lc = light.color
-        scale = np.array([(lc >> 11) / 31.0, ((lc >> 5) & 0x3F) / 63.0, (lc & 0x1F) / 31.0])
-        acc[lit] += np.asarray(f, np.float64)[lit, None] * channels[lit] * scale
-    ch = np.clip(np.floor(acc + 0.5), 0, [31, 63, 31]).astype(np.uint16)
-    return (ch[:, 0] << 11) | (ch[:, 1] << 5) | ch[:, 2], bad
+    def occluded(light: Light, lit: np.ndarray, l_lit: Vec) -> np.ndarray:
+        return _shadowed(ar, options, shapes, bounds, light, _take(point, lit), l_lit, hp[lit], slot[lit], st, nan_pixel)
+
+    return diffuse(ar, shapes.color[slot], normal, point, lights, occluded, options.intensity_fixed, record)
 
 
 def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, light: Light, origin: Vec,

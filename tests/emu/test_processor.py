@@ -97,3 +97,11 @@ def test_scene_is_sparse_for_huge_indices():
 def test_frames_bound_must_be_positive():
     with pytest.raises(Rend3rError, match="at least 1"):
         _frames(Prog().nf().words, frames=0)
+
+
+def test_device_er_halts_only_before_a_zero_word():
+    words = Prog().nr().er().nf().er().er().words  # er, nf: the device skips the first er
+    ex, seen = _frames(words, EmuOptions(er_needs_zero=True))
+    assert (ex.frames, ex.halt) == (1, "er")
+    ex, _ = _frames(words)
+    assert ex.frames == 0

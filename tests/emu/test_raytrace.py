@@ -173,3 +173,18 @@ def test_shapes_that_are_off_cost_nothing():
     prog = Prog().nr().sphere(0).shape(500000, xloc=1.0).sphere(9, kind=0).nf()
     _, st = render(prog)
     assert st.shapes == 1 and st.tests + st.skipped == W * H
+
+
+def test_device_light_model_uses_light_0_only_white_and_full_strength():
+    prog = Prog().nr().sphere(0, col=0xFFFF).dir_light(0, col=0xF800, intensity=0.25).dir_light(1).nf()
+    spec, s1 = render(prog, width=65, height=49)
+    dev, s2 = render(prog, width=65, height=49, light_model="device")
+    assert (s1.lights, s2.lights) == (2, 1)
+    assert dev.rgb565[24, 32] == 0xFFFF  # light 0 as white at intensity 1, head-on
+
+
+def test_device_intensity_converter_wraps_above_a_quarter():
+    prog = Prog().nr().sphere(0, col=0xFFFF).dir_light(0).nf()
+    frame, _ = render(prog, width=65, height=49, intensity_fixed=True)
+    assert frame.rgb565[24, 32] == 0  # I = 1 -> 16384 wraps to 0 in 13 bits
+    assert (frame.rgb565[frame.provenance == 0] > 0).any()  # grazing parts (I < 0.25) stay lit

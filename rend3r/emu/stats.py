@@ -9,9 +9,18 @@ PIPELINE_CYCLES = 205
 CLOCK_HZ = 100e6
 
 
+#: Rasterizer: 63 cycles of projection and 4 of coverage set-up, then one pixel per cycle.
+RASTER_SETUP_CYCLES = 63 + 4
+
+
 def device_cycles(shapes: int, lights: int, pixels: int) -> int:
-    """The paper's estimate: (shapes + 205) * (lights + 1) * pixels."""
+    """The paper's raytracing estimate: (shapes + 205) * (lights + 1) * pixels."""
     return (shapes + PIPELINE_CYCLES) * (lights + 1) * pixels
+
+
+def raster_cycles(triangles: int, pixels: int) -> int:
+    """The paper's rasterization estimate: (63 + 4 + pixels) cycles per triangle."""
+    return triangles * (RASTER_SETUP_CYCLES + pixels)
 
 
 @dataclass
@@ -30,9 +39,12 @@ class FrameStats:
     nan_rays: int = 0  # pixels whose primary or shadow ray met a NaN or infinity
     hits: int = 0  # pixels showing a shape
     seconds: float = 0.0
+    mode: str = "raytrace"  # or "raster": shapes are triangles, and the cycle model differs
 
     @property
     def device_cycles(self) -> int:
+        if self.mode == "raster":
+            return raster_cycles(self.shapes, self.pixels)
         return device_cycles(self.shapes, self.lights, self.pixels)
 
     @property
@@ -57,7 +69,7 @@ class RunStats:
 
     def report(self) -> str:
         """A human-readable table for ``--stats``."""
-        counters = [f.name for f in fields(FrameStats) if f.name not in ("number", "seconds")]
+        counters = [f.name for f in fields(FrameStats) if f.name not in ("number", "seconds", "mode")]
         lines = [f"instructions executed: {self.instructions} (halted by {self.halt})"]
         for f in self.frames:
             parts = ", ".join(f"{n.replace('_', ' ')} {getattr(f, n)}" for n in counters)

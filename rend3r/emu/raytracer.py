@@ -16,7 +16,7 @@ import numpy as np
 
 from .arith import Arith
 from .camera import camera_rays
-from .cull import Bounds, Tiles, cone_keep, make_tiles, pairs, parallel_keep, shape_blocks, shape_bounds
+from .cull import PAIR_CHUNK, Bounds, Tiles, cone_keep, make_tiles, pairs, parallel_keep, shape_blocks, shape_bounds
 from .frame import Frame
 from .lighting import Recorder, diffuse
 from .lights import POINT, Light, lights_from_scene
@@ -99,15 +99,24 @@ def render_frame(
         near, tables, S_shape = _primary(ar, options, rays, dd, shapes, bounds, st, nan_pixel, progress)
         hp = np.nonzero(near.slot != _NONE)[0]
         slot = near.slot[hp]
-        s = shapes.take(slot)
-        D = _take(rays.direction, hp)
-        if tables is None:
-            _, Dh = to_object(ar, s, None, D)
-        else:
-            cls, n, tab = tables
-            row = cls[slot] * n + hp
-            Dh = (tab[0][row], tab[1][row], tab[2][row])
-        point, normal = surface(ar, s, _take(S_shape, slot), Dh, near.t[hp], rays.origin, D)
+
+        def hit_surface(job):
+            lo, hi = job
+            px, sl = hp[lo:hi], slot[lo:hi]
+            s = shapes.take(sl)
+            D = _take(rays.direction, px)
+            if tables is None:
+                _, Dh = to_object(ar, s, None, D)
+            else:
+                cls, n, tab = tables
+                row = cls[sl] * n + px
+                Dh = (tab[0][row], tab[1][row], tab[2][row])
+            return surface(ar, s, _take(S_shape, sl), Dh, near.t[px], rays.origin, D)
+
+        parts = list(_parallel(hit_surface, [(lo, lo + PAIR_CHUNK) for lo in range(0, len(hp), PAIR_CHUNK)]))
+        empty = (np.zeros(0, ar.dtype),) * 3
+        point, normal = (tuple(np.concatenate([p[k][a] for p in parts]) if parts else empty[a] for a in range(3))
+                         for k in range(2))
         color, bad = shade_hits(ar, options, shapes, bounds, lights, hp, slot, point, normal, st, nan_pixel)
         nan_pixel[hp[bad]] = True
         hp, slot = hp[~bad], slot[~bad]
@@ -135,12 +144,15 @@ def _direction_tables(ar: Arith, shapes: Shapes, direction: Vec):
     n = len(direction[0])
     if len(first) * n > _CLASS_TABLE_LIMIT:
         return None
-    rows = []
-    for rep in first:
+    def row(job):
+        rep, lo, hi = job
         s = shapes.take(np.array([rep]))
-        _, Dh = to_object(ar, s, None, direction)
-        rows.append((*Dh, direction_term(ar, s, Dh)))
-    tables = [np.concatenate([r[k] for r in rows]) for k in range(4)]
+        _, Dh = to_object(ar, s, None, tuple(c[lo:hi] for c in direction))
+        return (*Dh, direction_term(ar, s, Dh))
+
+    jobs = [(rep, lo, min(n, lo + PAIR_CHUNK)) for rep in first for lo in range(0, n, PAIR_CHUNK)]
+    parts = list(_parallel(row, jobs))
+    tables = [np.concatenate([p[k] for p in parts]) for k in range(4)]
     return cls, n, tables
 
 

@@ -16,7 +16,7 @@ Pipeline, per frame (see ``docs/raster.md``):
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from time import perf_counter
 from typing import Callable
@@ -36,7 +36,7 @@ from .scene import Scene, prop_index
 from .stats import FrameStats
 from .vec import Quat, rotate_inverse
 
-DEPTH_MODES = ("zbuffer", "painter")
+DEPTH_MODES = ("zbuffer", "painter", "index")
 #: Projected coordinates stay within this many screen sizes of the screen centre.
 _GUARD_SCREENS = 8.0
 #: Fragments handled per batch: bounds memory on scenes with many large triangles.
@@ -70,6 +70,9 @@ class RasterRules:
 
 
 SPEC_RULES = RasterRules()
+#: The original device (quirk ``raster-pixel-snap``): whole-pixel vertices, integer
+#: sample positions, edges inside, zero-area triangles everywhere.
+DEVICE_RULES = RasterRules(subpixel_bits=0, centre_samples=False, fill_rule="inclusive")
 
 
 @dataclass
@@ -172,7 +175,7 @@ def rasterize(
     ``size`` is (width, height). Provenance holds the index into ``tris`` (-1: none).
     """
     if depth_mode not in DEPTH_MODES:
-        raise ValueError(f"unknown depth mode {depth_mode!r}; expected zbuffer or painter")
+        raise ValueError(f"unknown depth mode {depth_mode!r}; expected one of {', '.join(DEPTH_MODES)}")
     width, height = size
     stats = RasterStats(triangles=int(tris.shape[0]))
     rgb = np.full((height, width), background, dtype=np.uint16)
@@ -186,7 +189,8 @@ def rasterize(
     stats.clipped, stats.rejected, stats.nonfinite = scr.clipped, scr.rejected, scr.nonfinite
     sub, parent, fx, fy = scr.camera, scr.parent, scr.x, scr.y
 
-    # Draw order: table order for the z-buffer, centroid distance descending for painter.
+    # Draw order: table order for the z-buffer and index order, centroid distance
+    # descending for painter; painter and index order resolve alike (later draws win).
     if depth_mode == "painter":
         key = centroid_sq_distance(ar, cam)
         order = np.argsort(-key.astype(np.float64), kind="stable")
@@ -235,6 +239,7 @@ def render_triangles(
     background: int = 0,
     rules: RasterRules = SPEC_RULES,
     shading: bool = True,
+    intensity_fixed: bool = False,
 ) -> RasterResult:
     """Flat-shade triangles (N, 3, 3) with ``lights`` and rasterize them.
 
@@ -244,7 +249,7 @@ def render_triangles(
     colours = np.asarray(colours, dtype=np.uint16)
     bad = np.zeros(tris.shape[0], dtype=bool)
     if shading and tris.shape[0]:
-        colours, bad = flat_colours(ar, tris, colours, lights)
+        colours, bad = flat_colours(ar, tris, colours, lights, intensity_fixed)
     keep = np.flatnonzero(~bad)
     res = rasterize(tris[keep], colours[keep], view, ar, size, depth_mode, background, rules)
     res.provenance[res.provenance >= 0] = keep[res.provenance[res.provenance >= 0]]
@@ -256,11 +261,18 @@ def render_triangles(
 _VERTEX_PROPS = ("x1", "y1", "z1", "x2", "y2", "z2", "x3", "y3", "z3")
 
 
-def triangles_from_scene(scene: Scene, ar: Arith) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Every triangle the program wrote, in index order: (indices, vertices (N,3,3), colours)."""
+def triangles_from_scene(
+    scene: Scene, ar: Arith, next_triangle: bool = False
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every triangle the program wrote, in index order: (indices, vertices (N,3,3), colours).
+
+    ``next_triangle`` (device defect): slot A holds the data of triangle A+1.
+    """
     p = [prop_index(Table.TRIANGLE, n) for n in _VERTEX_PROPS]
     col = prop_index(Table.TRIANGLE, "col")
     rows = sorted(scene.objects.items())
+    if next_triangle:
+        rows = [(i, scene.objects.get(i + 1, {})) for i, _ in rows]
     index = np.fromiter((i for i, _ in rows), dtype=np.int64, count=len(rows))
     bits = np.array([[props.get(k, 0) for k in p] for _, props in rows], dtype=np.uint16).reshape(-1, 3, 3)
     colours = np.fromiter((props.get(col, 0) for _, props in rows), dtype=np.uint16, count=len(rows))
@@ -293,20 +305,28 @@ def render_frame(
     """Render the scene's triangles (the processor's ``nf`` hook in raster mode)."""
     start = perf_counter()
     ar = options.arith
-    index, tris, colours = triangles_from_scene(scene, ar)
-    lights = lights_from_scene(scene, ar)
+    index, tris, colours = triangles_from_scene(scene, ar, options.raster_next_triangle)
+    lights = lights_from_scene(scene, ar, options.light_model)
+    view = DEVICE_VIEW if options.raster_camera == "device" else view_from_scene(scene, ar)
+    rules = DEVICE_RULES if options.raster_rules == "device" else SPEC_RULES
+    rules = replace(rules, column_offset=options.raster_column_offset)
     res = render_triangles(
-        tris, colours, lights, view_from_scene(scene, ar), ar, (options.width, options.height),
-        getattr(options, "depth", "zbuffer"), options.background,
+        tris, colours, lights, view, ar, (options.width, options.height), options.depth, options.background,
+        rules, options.raster_shading, options.intensity_fixed,
     )
     prov = np.where(res.provenance >= 0, index[np.maximum(res.provenance, 0)], -1).astype(np.int32)
     st = FrameStats(
         number=number, pixels=options.pixels, shapes=len(index), lights=len(lights),
         nan_tests=res.stats.nonfinite, hits=int((prov >= 0).sum()), seconds=perf_counter() - start,
+        mode="raster",
     )
     if progress is not None:
         progress(1.0)
     return Frame(number, res.rgb565, res.depth, prov), st
+
+
+#: The device rasterizer's fixed projection (quirk ``raster-fixed-camera``).
+DEVICE_VIEW = RasterView(np.zeros(3, dtype=np.float32), None, 1.0, np.inf, (VIEW_WIDTH, VIEW_HEIGHT))
 
 
 def _clip_planes(ar: Arith, view: RasterView, width: int, height: int) -> ClipPlanes:
@@ -392,7 +412,7 @@ def _batches(cov):
 
 def _resolve(mode: str, pix: np.ndarray, d: np.ndarray, rank: np.ndarray, best_depth: np.ndarray, best_rank: np.ndarray) -> None:
     """Merge one batch of fragments into the frame's depth and rank buffers."""
-    if mode == "painter":
+    if mode != "zbuffer":
         # Later in draw order wins: the highest rank.
         cand = np.full(best_rank.shape, -1, dtype=np.int64)
         np.maximum.at(cand, pix, rank)

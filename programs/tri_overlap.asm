@@ -5,9 +5,9 @@
 ;         green over red; a blue triangle tilted in depth (z from -3 to -7) pierces both.
 ;         The two triangles sharing the edge at the bottom are given in opposite windings.
 ; Run:    rend3r emulate programs/tri_overlap.asm --mode raster -o tri_overlap.png
-; Look:   red in front of green where they overlap; the blue sliver passes in front of
-;         them at its left end and behind them at its right end; a yellow/cyan pair of
-;         triangles at the bottom joined without a gap.
+; Look:   red in front of green where they overlap; the blue sliver, slanting away to
+;         the right, passes behind the red triangle but in front of the green one; a
+;         yellow/cyan pair of triangles at the bottom joined without a gap.
 ; frames: 1
 ; mode: raster
 

@@ -6,8 +6,8 @@
 ;         from outside. Each facet's colour is made
 ;         from its ring (red up, blue down the rings) and segment (green around).
 ; Run:    rend3r emulate programs/tri_sphere.asm --mode raster -o tri_sphere.png
-; Look:   a faceted ball made of coloured quads, red-green at the bottom, bluish at the
-;         top, with no holes between facets.
+; Look:   a faceted ball of flat-shaded quads, bluish at the top and dark red at the
+;         bottom, lit from the upper right, with no holes between facets.
 ; frames: 1
 ; mode: raster
 

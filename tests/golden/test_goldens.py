@@ -66,6 +66,9 @@ TOLERANCES: dict[str, Tolerance] = {
     "fp16_grazing": Tolerance(None, 0.03, 33.0, "overflow near the vanishing point, grazing edges"),
     "fp16_limits": Tolerance(None, 0.34, 18.0, "shapes float16 cannot represent vanish by design"),
     "fp16_underflow": Tolerance(None, 0.027, 28.5, "flush-to-zero squares by design"),
+    "tri_cube": Tolerance(4, 0.0005, 46.0, "flat shading is exact away from edges; vertices snap differently"),
+    "tri_sphere": Tolerance(4, 0.0005, 48.0, "flat shading is exact away from edges; vertices snap differently"),
+    "tri_overlap": Tolerance(4, 0.001, 32.0, "the slanted blue triangle's crossing edges"),
 }
 
 

@@ -197,6 +197,7 @@ class Assembler:
                 if body is None:
                     self.statements += 1
                     if self.statements > MAX_STATEMENTS:
+                        self.where = (file, lineno, line, context)
                         self.too_large()
                     entries.append(Emitted(self.address, words, loc, line))
                     self.address += len(words)

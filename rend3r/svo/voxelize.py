@@ -116,10 +116,32 @@ def _unique_rows(coords: np.ndarray, n: int) -> np.ndarray:
     return np.stack([key // (n * n), (key // n) % n, key % n], 1)
 
 
+def _weight(tri: np.ndarray, n: int) -> np.ndarray:
+    """Upper bound of the candidate voxels of each triangle (columns x 3)."""
+    span = np.clip(np.ceil(tri.max(1) - tri.min(1)) + 2, 1, n)
+    return np.sort(span, axis=1)[:, 1:].prod(1).astype(np.int64) * 3
+
+
+def _split_large(tri: np.ndarray, n: int) -> np.ndarray:
+    """Split triangles with more candidates than a batch into four, until none has.
+
+    The pieces cover the same points, so the overlapped voxels do not change; only the
+    memory of one batch stays bounded.
+    """
+    done = []
+    while len(tri):
+        big = _weight(tri, n) > _CHUNK
+        done.append(tri[~big])
+        a, b, c = tri[big, 0], tri[big, 1], tri[big, 2]
+        ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
+        tri = np.concatenate([np.stack(p, 1) for p in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))])
+    return np.concatenate(done)
+
+
 def voxelize_surface(tri_grid: np.ndarray, n: int) -> np.ndarray:
     """Unique voxels (M, 3) overlapped by triangles given in grid units (voxel i = [i, i+1])."""
-    span = np.clip(np.ceil(tri_grid.max(1) - tri_grid.min(1)) + 2, 1, n)
-    weight = np.sort(span, axis=1)[:, 1:].prod(1).astype(np.int64) * 3
+    tri_grid = _split_large(tri_grid, n)
+    weight = _weight(tri_grid, n)
     parts = [_unique_rows(_surface_chunk(tri_grid[s], n), n) for s in _batches(weight, _CHUNK)]
     return _unique_rows(np.concatenate(parts), n)
 

@@ -89,3 +89,11 @@ def test_file_round_trip_and_errors(tmp_path):
             decode_svo(bad)
     with pytest.raises(Rend3rError, match="cannot read"):
         read_svo(tmp_path / "missing.svo")
+
+
+def test_deep_sparse_tree_needs_no_dense_grid():
+    """Depth 16 (65536^3 voxels) with a few thousand voxels builds in proportion to them."""
+    coords = random_voxels(16, 3000, 9)
+    tree = build_octree(coords, 16)
+    assert len(tree.words) < 16 * len(coords)
+    assert np.array_equal(octree_to_voxels(tree), _sorted(coords, 16))

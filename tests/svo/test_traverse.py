@@ -137,3 +137,18 @@ def test_recorded_requests_match_counts(small_tree):
     first = np.r_[True, res.trace_ray[1:] != res.trace_ray[:-1]]
     assert np.all(res.trace_addr[first] == 0) and np.all(res.trace_level[first] == 0)
     assert res.trace_addr.max() < len(tree.words)
+
+
+def test_far_pointers_trace_like_near_pointers():
+    coords = random_voxels(5, 900, 21)
+    near = build_octree(coords, 5)
+    far = build_octree(coords, 5, ptr_bits=4)
+    assert far.far_count() > 0
+    o, d = _rays(800, 8)
+    a = trace(near, o, d, 2, True, record=True)
+    b = trace(far, o, d, 2, True, record=True)
+    assert np.array_equal(a.voxel, b.voxel) and np.array_equal(a.t, b.t)
+    assert np.array_equal(a.steps, b.steps)
+    # each descent into a far node costs one extra request (the far slot)
+    assert b.requests.sum() > a.requests.sum()
+    assert np.all(b.requests - a.requests >= 0)

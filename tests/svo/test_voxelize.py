@@ -98,3 +98,22 @@ def test_errors():
         voxelize(np.zeros((3, 3)), np.array([[0, 1, 5]]), 3)
     with pytest.raises(Rend3rError):
         voxelize(np.array([[np.nan, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]), 3)
+
+
+def test_deep_grid_small_triangle():
+    """Depth 16: a small triangle in a 65536^3 grid voxelises without a dense grid."""
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0],  # these two only set the bounds
+                  [0.5, 0.5, 0.5], [0.5005, 0.5001, 0.5], [0.5, 0.5004, 0.5003]])
+    coords, lo, h = voxelize(v, np.array([[2, 3, 4]]), 16)
+    assert 200 < len(coords) < 20000
+    centre = (np.array([0.5, 0.5, 0.5]) - lo) / h
+    assert np.all(np.abs(coords - centre) < 60)
+
+
+def test_large_triangles_are_split_without_changing_the_result(monkeypatch):
+    from rend3r.svo import voxelize as vox
+    v, f = sphere(6)
+    coords, lo, h = voxelize(v, f, 6)
+    monkeypatch.setattr(vox, "_CHUNK", 64)  # forces every triangle to be split many times
+    split, _, _ = voxelize(v, f, 6)
+    assert _as_set(split) == _as_set(coords)

@@ -129,7 +129,13 @@ def cone_keep(tiles: Tiles, apex: np.ndarray, dirs: np.ndarray, origins: np.ndar
 
 def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: Bounds, sel: np.ndarray,
                   fp16: bool) -> np.ndarray:
-    """(tiles, len(sel)) mask: parallel rays from the tile's origins (tile order) may hit."""
+    """(tiles, len(sel)) mask: parallel rays (t > 0) from the tile's origins (tile order) may hit.
+
+    A shape is skipped when it is off every ray line (as in :func:`cone_keep`), or when it
+    lies behind every origin: then the computed b = 2 D.S is positive and c2 too, so
+    ``sqrt(b*b - a2*c2) <= b`` (sqrt(fl(b*b)) = |b| in round-to-nearest) and neither root
+    is positive.
+    """
     d, dlen = _unit(direction)
     e1 = np.cross(d, [1.0, 0.0, 0.0] if abs(d[0]) < 0.9 else [0.0, 1.0, 0.0])
     e1 /= np.linalg.norm(e1)
@@ -138,11 +144,23 @@ def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: B
     p2 = origins @ basis
     lo = _tile_reduce(tiles, p2, np.minimum)
     hi = _tile_reduce(tiles, p2, np.maximum)
-    c2 = b.center[sel] @ basis
+    centers = b.center[sel]
+    c2 = centers @ basis
     gap = np.maximum(0.0, np.maximum(lo[:, None, :] - c2[None], c2[None] - hi[:, None, :]))
-    dist = _origin_distance(tiles, origins, b.center[sel])
+    dist = _origin_distance(tiles, origins, centers)
     r = cull_radius(b, sel, dist, np.full((len(tiles), 1), dlen), fp16)
-    return (np.linalg.norm(gap, axis=2) <= r) | ~np.isfinite(r)
+    keep = (np.linalg.norm(gap, axis=2) <= r) | ~np.isfinite(r)
+    # behind: min over the tile of (origin - centre).d, and the nearest origin's distance
+    ahead = _tile_reduce(tiles, origins @ d, np.minimum)[:, None] - (centers @ d)[None, :]
+    lo3, hi3 = _tile_reduce(tiles, origins, np.minimum), _tile_reduce(tiles, origins, np.maximum)
+    near = np.linalg.norm(np.maximum(0.0, np.maximum(lo3[:, None] - centers[None], centers[None] - hi3[:, None])), axis=2)
+    smin, smax = b.smin[sel], b.smax[sel]
+    with np.errstate(all="ignore"):
+        u = U16 + FTZ / np.minimum(1.0, (smin * dlen) ** 2)
+        mean2, spread2 = (smax**2 + smin**2) / 2, (smax**2 - smin**2) / 2
+        ds_low = dlen * (mean2 * ahead - (spread2 + 64.0 * u * smax**2) * dist)  # computed D.S stays above
+        behind = (ds_low > 2.0**-6) & (near > r) & np.isfinite(r)
+    return keep & ~behind
 
 
 def _origin_distance(tiles: Tiles, origins: np.ndarray, centers: np.ndarray) -> np.ndarray:

@@ -35,6 +35,8 @@ class EmuOptions:
     light_model: LightModel = "spec"  # "device": light 0 only, directional, colour/intensity ignored
     intensity_fixed: bool = False  # the device's 13-bit converter of the light factor
     er_needs_zero: bool = False  # `er` halts only if the next word is zero too (device)
+    clear_frames: bool = True  # False: raster pixels no triangle covers keep the previous frame's value
+    display: Literal["rgb565", "rgb444"] = "rgb565"  # "rgb444": frames as the device's monitor shows them
     # Rasterizer switches (read by raster.py, see docs/raster.md and docs/device-profile.md)
     raster_camera: Literal["spec", "device"] = "spec"
     raster_shading: bool = True

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Sequence
+
+import numpy as np
 
 from ..errors import Rend3rError
 from .frame import Frame
@@ -21,6 +23,14 @@ ProgressHook = Callable[[int, float], None]
 class RunResult:
     frames: list[Frame] = field(default_factory=list)
     stats: RunStats = field(default_factory=RunStats)
+
+
+def rgb444_display(rgb565: np.ndarray) -> np.ndarray:
+    """What the device's monitor shows: the low 12 bits as RGB444, back in RGB565 form
+    (each 4-bit channel widened by bit replication)."""
+    c = rgb565.astype(np.uint16)
+    r, g, b = (c >> 8) & 0xF, (c >> 4) & 0xF, c & 0xF
+    return ((((r << 1) | (r >> 3)) << 11) | (((g << 2) | (g >> 2)) << 5) | ((b << 1) | (b >> 3))).astype(np.uint16)
 
 
 def _renderer(options: EmuOptions):
@@ -55,9 +65,17 @@ def run_program(
     render = _renderer(options)
     result = RunResult()
 
+    previous: list[Frame] = []
+
     def on_nf(scene: Scene, number: int) -> None:
         hook = (lambda f: progress(number, f)) if progress is not None else None
         frame, st = render(scene, options, number, hook)
+        if options.mode == "raster" and not options.clear_frames and previous:
+            kept = np.where(frame.provenance >= 0, frame.rgb565, previous[0].rgb565)
+            frame = replace(frame, rgb565=kept.astype(np.uint16))
+        previous[:] = [frame]
+        if options.display == "rgb444":
+            frame = replace(frame, rgb565=rgb444_display(frame.rgb565))
         result.stats.frames.append(st)
         if keep_frames:
             result.frames.append(frame)

@@ -105,3 +105,12 @@ def test_device_er_halts_only_before_a_zero_word():
     assert (ex.frames, ex.halt) == (1, "er")
     ex, _ = _frames(words)
     assert ex.frames == 0
+
+
+def test_rgb444_display_widens_the_low_12_bits():
+    import numpy as np
+
+    from rend3r.emu.run import rgb444_display
+
+    got = rgb444_display(np.array([0xF800, 0x0FFF, 0x0123], np.uint16))
+    assert got.tolist() == [(17 << 11), 0xFFFF, (2 << 11) | (8 << 5) | 6]

@@ -122,6 +122,8 @@ def primary_rays(cam: Camera, model: np.ndarray) -> PrimaryRays:
     q1 = _apply(p_inv, np.stack([x, y, np.ones_like(x)], 1))
     mv_inv = np.linalg.inv(cam.view() @ model)
     p0, p1 = _apply(mv_inv, q0), _apply(mv_inv, q1)
+    if not (np.all(np.isfinite(p0)) and np.all(np.isfinite(p1))):
+        raise Rend3rError("camera or model transform is degenerate (non-finite rays)")
     return PrimaryRays(p0, p1 - p0, q0, q1)
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import Rend3rError
 from .camera import Camera
 
 
@@ -100,6 +101,8 @@ def program_hybrid(model, program: str, model_matrix: np.ndarray, width: int, he
     inv = np.linalg.inv(model_matrix)
     out = []
     for frame, (o, d) in zip(result.frames, rays):
+        if not (np.all(np.isfinite(o)) and np.all(np.isfinite(d)) and np.all(np.abs(d).sum(1) > 0)):
+            raise Rend3rError(f"{program}: frame {frame.number}: the camera produces non-finite or zero rays")
         o_oct = inv[:3, :3] @ o + inv[:3, 3]
         d_oct = d @ inv[:3, :3].T
         res = trace(model.tree, np.broadcast_to(o_oct, d.shape), d_oct, stack_depth)

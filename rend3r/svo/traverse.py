@@ -96,8 +96,9 @@ def setup_rays(origin: np.ndarray, direction: np.ndarray):
     d = np.asarray(direction, dtype=np.float64).reshape(-1, 3)
     scale = np.linalg.norm(d, axis=1)
     bad = ~np.isfinite(scale) | (scale == 0) | ~np.all(np.isfinite(o), axis=1)
-    scale = np.where(bad, 1.0, scale)
-    dn = clamp_direction(np.where(bad[:, None], 1.0, d) / scale[:, None])
+    if bad.any():
+        raise ValueError(f"{int(bad.sum())} rays have a non-finite origin or a zero/non-finite direction")
+    dn = clamp_direction(d / scale[:, None])
     neg = dn < 0
     dmask = (neg[:, 0] * 4 + neg[:, 1] * 2 + neg[:, 2]).astype(np.int64)
     om = np.where(neg, -o, o)
@@ -106,7 +107,7 @@ def setup_rays(origin: np.ndarray, direction: np.ndarray):
     t1 = ((1.0 - om) / dm).T
     enter = t0.max(0)
     leave = t1.min(0)
-    hits = ~bad & (enter < leave) & (leave > 0)
+    hits = (enter < leave) & (leave > 0)
     shift = np.where(hits, np.maximum(enter, 0.0), 0.0)
     return hits, dmask, t0 - shift, t1 - shift, shift, scale
 

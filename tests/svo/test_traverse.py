@@ -152,3 +152,11 @@ def test_far_pointers_trace_like_near_pointers():
     # each descent into a far node costs one extra request (the far slot)
     assert b.requests.sum() > a.requests.sum()
     assert np.all(b.requests - a.requests >= 0)
+
+
+def test_bad_rays_are_refused(small_tree):
+    _, tree = small_tree
+    with pytest.raises(ValueError):
+        trace(tree, np.array([[0.0, 0, 0]]), np.array([[0.0, 0, 0]]))
+    with pytest.raises(ValueError):
+        trace(tree, np.array([[np.nan, 0, 0]]), np.array([[1.0, 0, 0]]))

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class SourceLoc:
     """A position in a source file; line and column count from 1."""
 
@@ -21,7 +21,7 @@ class SourceLoc:
         return f"{self.file}:{self.line}:{self.col}"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Emitted:
     """The word(s) one source statement produced, at its address."""
 

@@ -90,7 +90,7 @@ def compare_command(
 
     \b
     Example:
-      rend3r compare programs/golden/sphere.f0.png out/sphere.png --max-channel 8 --diff d.png
+      rend3r compare programs/golden/sphere.png out/sphere.png --max-channel 8 --diff d.png
     """
     size = parse_size(size_text) if size_text else None
     m = compare_files(a, b, diff_path, size)

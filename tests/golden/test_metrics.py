@@ -16,6 +16,7 @@ from rend3r.golden.metrics import (
     image_metrics,
     interior_mask,
     provenance_metrics,
+    region_interior_mask,
     rgb565_to_rgb888,
 )
 
@@ -103,3 +104,27 @@ def test_diff_image_highlights_changed_pixels() -> None:
     assert d.shape == (2, 3, 3) and d.dtype == np.uint8
     assert d[1, 2].tolist()[1] == 0 and d[1, 2, 0] == d[1, 2, 2] >= 128
     assert d[0, 0].tolist() == [63, 63, 63]
+
+
+def test_region_interior_mask_separates_shapes() -> None:
+    prov = np.array(
+        [
+            [0, 0, 0, 1, 1, 1],
+            [0, 0, 0, 1, 1, 1],
+            [0, 0, 0, 1, 1, 1],
+        ],
+        dtype=np.int32,
+    )
+    mask = region_interior_mask(prov)
+    # columns 2 and 3 touch the other shape; the rest see one shape in all 3x3 neighbours
+    assert mask.tolist() == [[True, True, False, False, True, True]] * 3
+
+
+def test_masked_metrics_count_only_masked_pixels() -> None:
+    a = np.zeros((2, 2), dtype=np.uint16)
+    b = a.copy()
+    b[0, 0] = 0xFFFF
+    mask = np.array([[False, True], [True, True]])
+    m = image_metrics(a, b, mask)
+    assert (m.pixels, m.differing, m.max_channel) == (3, 0, 0)
+    assert image_metrics(a, b, ~mask).max_channel == 255

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import Rend3rError
 
-_CHUNK = 1 << 21  # candidate (triangle, voxel) pairs per vectorised batch
+_CHUNK = 1 << 19  # candidate (triangle, voxel) pairs per vectorised batch
 
 
 def fit_bounds(verts: np.ndarray, depth: int) -> tuple[np.ndarray, float]:
@@ -109,11 +109,18 @@ def _batches(weights: np.ndarray, limit: int):
         start = stop
 
 
+def _keys(coords: np.ndarray, n: int) -> np.ndarray:
+    """Sorted unique linear keys ``(x*n + y)*n + z`` of voxel coordinates."""
+    key = np.sort((coords[:, 0] * n + coords[:, 1]) * n + coords[:, 2])
+    return key[np.r_[True, key[1:] != key[:-1]]]
+
+
+def _rows(keys: np.ndarray, n: int) -> np.ndarray:
+    return np.stack([keys // (n * n), (keys // n) % n, keys % n], 1)
+
+
 def _unique_rows(coords: np.ndarray, n: int) -> np.ndarray:
-    key = (coords[:, 0] * n + coords[:, 1]) * n + coords[:, 2]
-    key = np.sort(key)
-    key = key[np.r_[True, key[1:] != key[:-1]]]
-    return np.stack([key // (n * n), (key // n) % n, key % n], 1)
+    return _rows(_keys(coords, n), n)
 
 
 def _weight(tri: np.ndarray, n: int) -> np.ndarray:
@@ -142,8 +149,10 @@ def voxelize_surface(tri_grid: np.ndarray, n: int) -> np.ndarray:
     """Unique voxels (M, 3) overlapped by triangles given in grid units (voxel i = [i, i+1])."""
     tri_grid = _split_large(tri_grid, n)
     weight = _weight(tri_grid, n)
-    parts = [_unique_rows(_surface_chunk(tri_grid[s], n), n) for s in _batches(weight, _CHUNK)]
-    return _unique_rows(np.concatenate(parts), n)
+    # batches keep only their unique keys (8 bytes a voxel) until the final merge
+    keys = np.concatenate([_keys(_surface_chunk(tri_grid[s], n), n) for s in _batches(weight, _CHUNK)])
+    keys = np.sort(keys)
+    return _rows(keys[np.r_[True, keys[1:] != keys[:-1]]], n)
 
 
 def fill_solid(tri_grid: np.ndarray, n: int) -> np.ndarray:

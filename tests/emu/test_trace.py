@@ -1,0 +1,91 @@
+"""Pixel traces: the worked device vectors, agreement with the frame, the JSON schema."""
+
+import io
+import json
+
+import numpy as np
+from click.testing import CliRunner
+
+from rend3r.cli import main
+from rend3r.emu.options import EmuOptions
+from rend3r.emu.processor import execute
+from rend3r.emu.raytracer import render_frame
+from rend3r.emu.scene import Scene
+from rend3r.emu.trace import jsonl_sink, trace_raytrace
+from rend3r.emu.trace_diff import first_divergence, parse_record
+
+from .scenes import Prog
+
+DEVICE = EmuOptions(camera="device", light_model="device")
+WORKED = Prog().nr().sphere(0, loc=(0.0, 0.0, -2.0), col=0xFFFF).light(0, src=1, xfor=1, yfor=1, zfor=0).nf().er()
+
+
+def _records(words, options, pixels):
+    scene = Scene()
+    execute(words, options, scene=scene)
+    out = []
+    trace_raytrace(scene, options, 0, pixels, out.append)
+    return scene, out
+
+
+def _stage(records, pixel, stage):
+    (r,) = [r for r in records if r["pixel"] == list(pixel) and r["stage"] == stage]
+    return r
+
+
+def test_worked_vectors_bit_for_bit():
+    _, recs = _records(WORKED.words, DEVICE, [(256, 192), (252, 188)])
+    want = {
+        (256, 192): dict(a2="0x4000", b="0xc400", c2="0x4600", disc="0x4400", sqrt="0x4000",
+                         t1="0x3c00", t2="0x4200", t="0x3c00", sq_dist="0x3c00"),
+        (252, 188): dict(a2="0x4009", b="0xc400", c2="0x4600", t="0x3c05", sq_dist="0x3c13"),
+    }
+    for pixel, stages in want.items():
+        for stage, hx in stages.items():
+            assert _stage(recs, pixel, stage)["hex"] == hx, (pixel, stage)
+    assert _stage(recs, (252, 188), "L0.cos")["hex"] == "0x2e22"
+    assert _stage(recs, (256, 192), "L0.cos")["dec"] < 0
+    assert _stage(recs, (256, 192), "colour")["dec"] == 0  # I negative: black
+    assert _stage(recs, (256, 192), "nearest")["dec"] == 0
+
+
+def test_stage_order_follows_the_device():
+    _, recs = _records(WORKED.words, DEVICE, [(252, 188)])
+    stages = [r["stage"] for r in recs]
+    per_shape = ["origin.x", "origin.y", "origin.z", "dir.x", "dir.y", "dir.z", "a2", "b", "c2", "disc", "sqrt",
+                 "t1", "t2", "t", "hit", "sq_dist", "point.x", "point.y", "point.z", "normal.x", "normal.y", "normal.z"]
+    assert stages[: len(per_shape)] == per_shape
+    assert stages[len(per_shape)] == "nearest" and stages[-1] == "colour"
+    assert stages.index("L0.cos") > stages.index("L0.n_dot_l")
+
+
+def test_trace_colour_is_the_frame_pixel_with_shadows_lights_and_misses():
+    prog = (Prog().nr().cam(xloc=0.3)
+            .sphere(0, loc=(0.0, 0.0, -4.0), col=0xFFFF)
+            .sphere(1, loc=(1.0, 1.2, -2.5), scale=(2.5, 2.5, 2.5), col=0x07E0)
+            .shape(2, type=2, col=0x001F, xloc=-2.0, zloc=-5.0, rrot=1.0, xscl=2.0, yscl=2.0, zscl=1.0)
+            .dir_light(0, forward=(-0.6, -0.8, -0.5)).dir_light(3, forward=(0.5, 0.1, -1.0), col=0xF81F, intensity=0.5)
+            .nf().er())
+    opts = EmuOptions(width=64, height=48)
+    pixels = [(x, y) for x in range(0, 64, 9) for y in range(0, 48, 7)] + [(33, 21)]  # (33, 21) is in shadow
+    scene, recs = _records(prog.words, opts, pixels)
+    frame, _ = render_frame(scene, opts)
+    for x, y in pixels:
+        assert _stage(recs, (x, y), "colour")["dec"] == int(frame.rgb565[y, x]), (x, y)
+        assert _stage(recs, (x, y), "nearest")["dec"] == int(frame.provenance[y, x]), (x, y)
+    assert any(r["stage"].endswith(".shadow") and r["dec"] == 1 for r in recs)
+
+
+def test_records_parse_with_the_diff_reader_and_self_compare_equal():
+    _, recs = _records(WORKED.words, DEVICE, [(252, 188)])
+    buf = io.StringIO()
+    sink = jsonl_sink(buf)
+    for r in recs:
+        sink(r)
+    lines = buf.getvalue().splitlines()
+    parsed = [parse_record(line, "t", n) for n, line in enumerate(lines, 1)]
+    assert first_divergence(parsed, parsed) is None
+    for r in recs:
+        assert set(r) == {"frame", "pixel", "shape", "stage", "hex", "dec"}
+        if r["hex"].startswith("0x") and len(r["hex"]) == 6 and isinstance(r["dec"], float):
+            assert np.array(int(r["hex"], 16), np.uint16).view(np.float16) == np.float16(r["dec"])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import sys
 
 import click
@@ -12,7 +13,9 @@ _EPILOG = """\b
 Examples:
   rend3r emulate programs/sphere.asm -o sphere.png
   rend3r emulate programs/animation.asm --frames 24 -o out/frame_{n:03}.png --gif anim.gif
-  rend3r emulate sphere.mem -o s.png --precision fp32 --size 256x192 --depth d.png --stats
+  rend3r emulate sphere.mem -o s.png --precision fp32 --size 256x192 --depth-image d.png --stats
+  rend3r emulate programs/tri_cube.asm -o cube.png --depth painter
+  rend3r emulate programs/sphere.asm -o board.png --profile rend3r-2022 --trace-pixel 252,188 --trace t.jsonl
 """
 
 
@@ -45,31 +48,58 @@ def _colour(ctx, param, value: str) -> int:
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormals: flush to zero (the device's IP) or IEEE gradual underflow.")
 @click.option("--size", default="512x384", show_default=True, callback=_size, help="Image size WxH.")
 @click.option("--background", default="0x0000", show_default=True, callback=_colour, help="RGB565 colour where no shape is hit.")
-@click.option("--depth", "depth_path", help="Depth image per frame: .npy (float32 distances) or 16-bit PNG.")
+@click.option("--depth", "depth", help="Raster visibility: zbuffer (default) or painter. Any other value is taken as --depth-image FILE.")
+@click.option("--depth-image", "depth_path", help="Depth image per frame: .npy (float32 distances) or 16-bit PNG.")
 @click.option("--provenance", "prov_path", help="Which shape made each pixel: .npy (int32, -1 none) or PNG.")
 @click.option("--gif", "gif_path", help="All frames as an animated GIF.")
 @click.option("--apng", "apng_path", help="All frames as an animated PNG (lossless).")
 @click.option("--stats", "show_stats", is_flag=True, help="Print counters, times and the paper's device estimate.")
-def emulate_command(program, output, frames, mode, precision, subnormals, size, background,
-                    depth_path, prov_path, gif_path, apng_path, show_stats) -> None:
+@click.option("--profile", type=click.Choice(["rend3r-2022"]), help="Model the original board: every device quirk (docs/device-profile.md).")
+@click.option("--device-quirk", "quirks", multiple=True, metavar="NAME", help="Switch on one device quirk (repeatable); names in docs/device-profile.md.")
+@click.option("--trace-pixel", "trace_pixels", multiple=True, metavar="X,Y", help="Trace every float16 intermediate of this pixel (repeatable; docs/trace.md).")
+@click.option("--trace", "trace_path", help="Write pixel traces (JSON lines) to FILE instead of standard output.")
+def emulate_command(program, output, frames, mode, precision, subnormals, size, background, depth,
+                    depth_path, prov_path, gif_path, apng_path, show_stats, profile, quirks, trace_pixels,
+                    trace_path) -> None:
     """Run a REND3R PROGRAM (source or memory image) and render its frames."""
     from .image import frame_path, is_pattern, save_animation, save_depth, save_png, save_provenance
     from .loader import load_program
     from .options import EmuOptions
     from .processor import execute
+    from .quirks import apply_quirks, quirk_names
     from .run import run_program
+    from .trace import parse_pixel
 
     if gif_path and apng_path:
         raise Rend3rError("--gif and --apng are exclusive: choose one animation format")
     if not (output or gif_path or apng_path):
         raise Rend3rError("nothing to write: give -o OUT (and/or --gif/--apng)")
+    visibility = "zbuffer"
+    if depth in ("zbuffer", "painter"):
+        visibility = depth
+    elif depth is not None:
+        if depth_path:
+            raise Rend3rError("--depth FILE and --depth-image FILE both name a depth image: give one")
+        depth_path = depth
+    try:
+        pixels = [parse_pixel(p) for p in trace_pixels]
+    except ValueError as exc:
+        raise Rend3rError(f"--trace-pixel: {exc}") from None
+    if trace_path and not pixels:
+        raise Rend3rError("--trace FILE needs at least one --trace-pixel X,Y")
     loaded = load_program(program)
     options = EmuOptions(precision=precision, subnormals=subnormals, mode=mode or loaded.mode_hint or "raytrace",
-                         width=size[0], height=size[1], background=background)
+                         width=size[0], height=size[1], background=background, depth=visibility)
+    options = apply_quirks(options, quirk_names(profile, quirks))
+    for x, y in pixels:
+        if not (0 <= x < options.width and 0 <= y < options.height):
+            raise Rend3rError(f"--trace-pixel {x},{y} is outside the {options.width}x{options.height} frame")
+    if pixels and options.mode != "raytrace":
+        raise Rend3rError("--trace-pixel traces the raytracer; raster mode has no trace yet (docs/trace.md)")
     count = execute(loaded.words, options, frames).frames
     if count == 0:
         raise Rend3rError(f"{program}: the program renders no frame (no nf is executed)")
-    for opt, path in (("-o", output), ("--depth", depth_path), ("--provenance", prov_path)):
+    for opt, path in (("-o", output), ("--depth-image", depth_path), ("--provenance", prov_path)):
         if path and count > 1 and not is_pattern(path):
             raise Rend3rError(f"the program renders {count} frames: {opt} needs a pattern such as out/frame_{{n:03}}.png")
     animate = gif_path or apng_path
@@ -90,11 +120,28 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
         if bar is not None:
             bar.update(int((number + fraction) * 1000) - bar.pos)
 
+    trace_buf = io.StringIO()
+    on_scene = None
+    if pixels:
+        from .trace import jsonl_sink, trace_raytrace
+
+        sink = jsonl_sink(trace_buf)
+
+        def on_scene(scene, number: int) -> None:
+            trace_raytrace(scene, options, number, pixels, sink)
+
     try:
-        result = run_program(loaded.words, options, frames, on_frame, progress, keep_frames=False)
+        result = run_program(loaded.words, options, frames, on_frame, progress, keep_frames=False, on_scene=on_scene)
     finally:
         if bar is not None:
             bar.render_finish()
+    if pixels:
+        if trace_path:
+            from ..fileio import write_atomic
+
+            write_atomic(trace_path, trace_buf.getvalue().encode())
+        else:
+            click.echo(trace_buf.getvalue(), nl=False)
     if animate:
         save_animation(rgb_frames, animate, "gif" if gif_path else "apng")
     nan = result.stats.nan_rays

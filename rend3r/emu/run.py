@@ -15,6 +15,8 @@ from .scene import Scene
 from .stats import RunStats
 
 FrameHook = Callable[[Frame], None]
+#: Called at each ``nf`` with the scene about to be rendered and the frame number.
+SceneHook = Callable[[Scene, int], None]
 #: Called during rendering with (frame number, fraction of that frame done).
 ProgressHook = Callable[[int, float], None]
 
@@ -52,12 +54,14 @@ def run_program(
     on_frame: FrameHook | None = None,
     progress: ProgressHook | None = None,
     keep_frames: bool = True,
+    on_scene: SceneHook | None = None,
 ) -> RunResult:
     """Execute ``words``, rendering a frame at each ``nf`` (up to ``frames`` frames).
 
     The program is first run without rendering, so decoding errors and unbounded loops are
     reported before any time is spent on frames. ``keep_frames=False`` leaves
     ``result.frames`` empty (use ``on_frame`` to consume frames as they come).
+    ``on_scene`` sees each frame's scene (pixel traces use it).
     """
     options = options or EmuOptions()
     words = list(words)
@@ -69,6 +73,8 @@ def run_program(
 
     def on_nf(scene: Scene, number: int) -> None:
         hook = (lambda f: progress(number, f)) if progress is not None else None
+        if on_scene is not None:
+            on_scene(scene, number)
         frame, st = render(scene, options, number, hook)
         if options.mode == "raster" and not options.clear_frames and previous:
             kept = np.where(frame.provenance >= 0, frame.rgb565, previous[0].rgb565)

@@ -64,7 +64,7 @@ def _device_rays(origin: Vec, width: int, height: int, arith: Arith) -> Rays:
     return Rays(origin, (dx, dy, dz), arith.const(0.0), arith.const(np.inf))
 
 
-def _value(scene: Scene, name: str, arith: Arith, default: float) -> np.ndarray:
+def camera_value(scene: Scene, name: str, arith: Arith, default: float) -> np.ndarray:
     """A camera property's value; zero (as memory starts) means the default."""
     v = arith.from_bits(scene.camera.get(prop_index(Table.CAMERA, name), 0))
     return arith.const(default) if float(v) == 0.0 else v
@@ -94,9 +94,9 @@ def _viewport_axes(arith: Arith, width: int, height: int) -> tuple[np.ndarray, n
 
 def _spec_rays(scene: Scene, origin: Vec, width: int, height: int, arith: Arith) -> Rays:
     """Camera space (ux*hfov*n, uy*vfov*n, -n) rotated by q; t = 1 is the near plane."""
-    near = _value(scene, "nclip", arith, 1.0)
-    hfov = _value(scene, "hfov", arith, 1.0)
-    vfov = _value(scene, "vfov", arith, 1.0)
+    near = camera_value(scene, "nclip", arith, 1.0)
+    hfov = camera_value(scene, "hfov", arith, 1.0)
+    vfov = camera_value(scene, "vfov", arith, 1.0)
     ux, uy = _viewport_axes(arith, width, height)
     cx = arith.mul(arith.mul(ux, hfov), near)
     cy = arith.mul(arith.mul(uy, vfov), near)

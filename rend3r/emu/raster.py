@@ -25,7 +25,7 @@ import numpy as np
 
 from ..isa import Table
 from .arith import Arith
-from .camera import VIEW_HEIGHT, VIEW_WIDTH, camera_quaternion, _value
+from .camera import VIEW_HEIGHT, VIEW_WIDTH, camera_quaternion, camera_value
 from .frame import Frame
 from .lights import Light, lights_from_scene
 from .options import EmuOptions
@@ -286,8 +286,8 @@ def view_from_scene(scene: Scene, ar: Arith) -> RasterView:
     pixel rays the raytracer casts; zero (unset) near/fov mean the defaults, far 0 no bound.
     """
     loc = np.array([ar.from_bits(scene.camera_bits(n)) for n in ("xloc", "yloc", "zloc")], dtype=ar.dtype)
-    near = _value(scene, "nclip", ar, 1.0)
-    hfov, vfov = _value(scene, "hfov", ar, 1.0), _value(scene, "vfov", ar, 1.0)
+    near = camera_value(scene, "nclip", ar, 1.0)
+    hfov, vfov = camera_value(scene, "hfov", ar, 1.0), camera_value(scene, "vfov", ar, 1.0)
     far = float(ar.from_bits(scene.camera_bits("fclip")))
     canvas = (ar.mul(ar.mul(ar.const(VIEW_WIDTH), hfov), near), ar.mul(ar.mul(ar.const(VIEW_HEIGHT), vfov), near))
     return RasterView(

@@ -140,13 +140,15 @@ def summary_sentences(rows: list[Row]) -> list[str]:
         for a, b in zip(by_mode["fp16-ftz"], by_mode["fp16-ieee"], strict=True)
         if (a.psnr, a.share_differing, a.silhouette) != (b.psnr, b.share_differing, b.silhouette)
     )
-    t = {m: statistics.median(r.seconds_per_frame for r in mr) for m, mr in by_mode.items()}
+    fp64_t = {r.program: r.seconds_per_frame for r in by_mode["fp64"]}
+    t = {m: statistics.median(r.seconds_per_frame / fp64_t[r.program] for r in mr) for m, mr in by_mode.items()}
+    differs16 = sum(not math.isinf(r.psnr) for r in by_mode["fp16-ftz"])
     return [
-        f"fp32 renders {fp32_exact} of {n} programs bit-identical to fp64 at {t['fp32'] / t['fp64']:.2f}x its time; "
-        f"emulated fp16 (every operation rounded to float16) costs {t['fp16-ftz'] / t['fp64']:.2f}x (ftz) and "
-        f"{t['fp16-ieee'] / t['fp64']:.2f}x (ieee) the time of fp64 and differs from it on every program. "
+        f"fp32 renders {fp32_exact} of {n} programs bit-identical to fp64 in {t['fp32']:.2f}x its time (median "
+        f"over programs); emulated fp16 (every operation rounded to float16) takes {t['fp16-ftz']:.2f}x (ftz) and "
+        f"{t['fp16-ieee']:.2f}x (ieee) the time of fp64 and differs from it on {differs16} of {n} programs. "
         f"The largest fp16 errors are in {', '.join(f'{r.program} ({fmt_psnr(r.psnr)} dB)' for r in worst16)}. "
-        f"Flush-to-zero and IEEE subnormals give different frames on {ftz_vs_ieee} of {n} programs. "
+        f"Flush-to-zero and IEEE subnormals give different error figures on {ftz_vs_ieee} of {n} programs. "
         "See `numerics.md` for what causes each error and how to avoid it.",
     ]
 

@@ -43,7 +43,7 @@ def _colour(ctx, param, value: str) -> int:
 @click.argument("program", type=click.Path(dir_okay=False))
 @click.option("-o", "--output", help="PNG per frame: a name, or a pattern like out/frame_{n:03}.png for several.")
 @click.option("--frames", type=int, help="Render at most N frames (required for programs that loop with lr).")
-@click.option("--mode", type=click.Choice(["raytrace", "raster"]), help="How SE/SD data is read (default: from the source's sp/tr, else raytrace).")
+@click.option("--mode", type=click.Choice(["raytrace", "raster", "hybrid"]), help="How SE/SD data is read (default: from the source's sp/tr, else raytrace); hybrid: shapes and triangles in one frame (docs/isa-extensions.md).")
 @click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormals: flush to zero (the device's IP) or IEEE gradual underflow.")
 @click.option("--size", default="512x384", show_default=True, callback=_size, help="Image size WxH.")

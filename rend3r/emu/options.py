@@ -11,7 +11,7 @@ from typing import Literal
 
 from .arith import Arith, Precision, make_arith
 
-Mode = Literal["raytrace", "raster"]
+Mode = Literal["raytrace", "raster", "hybrid"]
 DepthRule = Literal["zbuffer", "painter", "index"]
 LightModel = Literal["spec", "device"]
 CameraModel = Literal["spec", "device"]

@@ -14,6 +14,7 @@ from typing import Callable, Sequence
 from ..errors import Rend3rError
 from ..isa import CameraSet, FrameOp, Func, LightSet, ShapeSet, Table, TrailingSE, Unknown, decode_word
 from ..isa.tables import OPCODE, Opcode
+from .isa_ext import decode_table_select
 from .options import EmuOptions
 from .scene import Scene
 
@@ -64,7 +65,12 @@ def execute(
         here = f"address {pc} (0x{pc:04x})"
         executed += 1
         if isinstance(ins, Unknown):
-            raise Rend3rError(f"{here}: unknown opcode 0b{OPCODE.get(ins.word):03b} in word 0x{ins.word:08x}")
+            selected = decode_table_select(ins.word) if options.mode == "hybrid" else None
+            if selected is None:
+                raise Rend3rError(f"{here}: unknown opcode 0b{OPCODE.get(ins.word):03b} in word 0x{ins.word:08x}")
+            table = selected
+            pc += size
+            continue
         if isinstance(ins, TrailingSE):
             raise Rend3rError(f"{here}: SE word 0x{ins.word:08x} is the last word; its SD is missing")
         pc += size
@@ -73,7 +79,7 @@ def execute(
         elif isinstance(ins, LightSet):
             scene.set_light(ins)
         elif isinstance(ins, ShapeSet):
-            scene.set_object(ins, table)
+            scene.set_object(ins, table, scene.triangles if options.mode == "hybrid" and table is Table.TRIANGLE else None)
         elif isinstance(ins, FrameOp):
             if ins.func is Func.ER:
                 if not options.er_needs_zero or pc >= len(words) or words[pc] == 0:

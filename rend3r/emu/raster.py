@@ -262,17 +262,20 @@ _VERTEX_PROPS = ("x1", "y1", "z1", "x2", "y2", "z2", "x3", "y3", "z3")
 
 
 def triangles_from_scene(
-    scene: Scene, ar: Arith, next_triangle: bool = False
+    scene: Scene, ar: Arith, next_triangle: bool = False, store: dict[int, dict[int, int]] | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every triangle the program wrote, in index order: (indices, vertices (N,3,3), colours).
 
-    ``next_triangle`` (device defect): slot A holds the data of triangle A+1.
+    ``store`` is where SE/SD wrote them: ``scene.objects`` (raster mode, the default) or
+    ``scene.triangles`` (hybrid mode). ``next_triangle`` (device defect): slot A holds
+    the data of triangle A+1.
     """
     p = [prop_index(Table.TRIANGLE, n) for n in _VERTEX_PROPS]
     col = prop_index(Table.TRIANGLE, "col")
-    rows = sorted(scene.objects.items())
+    store = scene.objects if store is None else store
+    rows = sorted(store.items())
     if next_triangle:
-        rows = [(i, scene.objects.get(i + 1, {})) for i, _ in rows]
+        rows = [(i, store.get(i + 1, {})) for i, _ in rows]
     index = np.fromiter((i for i, _ in rows), dtype=np.int64, count=len(rows))
     bits = np.array([[props.get(k, 0) for k in p] for _, props in rows], dtype=np.uint16).reshape(-1, 3, 3)
     colours = np.fromiter((props.get(col, 0) for _, props in rows), dtype=np.uint16, count=len(rows))
@@ -300,12 +303,20 @@ def view_from_scene(scene: Scene, ar: Arith) -> RasterView:
 
 
 def render_frame(
-    scene: Scene, options: EmuOptions, number: int = 0, progress: Callable[[float], None] | None = None
+    scene: Scene,
+    options: EmuOptions,
+    number: int = 0,
+    progress: Callable[[float], None] | None = None,
+    store: dict[int, dict[int, int]] | None = None,
 ) -> tuple[Frame, FrameStats]:
-    """Render the scene's triangles (the processor's ``nf`` hook in raster mode)."""
+    """Render the scene's triangles (the processor's ``nf`` hook in raster mode).
+
+    ``store``: the triangle table to draw (default ``scene.objects``; see
+    :func:`triangles_from_scene`).
+    """
     start = perf_counter()
     ar = options.arith
-    index, tris, colours = triangles_from_scene(scene, ar, options.raster_next_triangle)
+    index, tris, colours = triangles_from_scene(scene, ar, options.raster_next_triangle, store)
     lights = lights_from_scene(scene, ar, options.light_model)
     view = DEVICE_VIEW if options.raster_camera == "device" else view_from_scene(scene, ar)
     rules = DEVICE_RULES if options.raster_rules == "device" else SPEC_RULES
@@ -314,7 +325,8 @@ def render_frame(
         tris, colours, lights, view, ar, (options.width, options.height), options.depth, options.background,
         rules, options.raster_shading, options.intensity_fixed,
     )
-    prov = np.where(res.provenance >= 0, index[np.maximum(res.provenance, 0)], -1).astype(np.int32)
+    lookup = np.append(index, -1)  # provenance -1 (no triangle) reads the appended -1
+    prov = lookup[res.provenance].astype(np.int32)
     st = FrameStats(
         number=number, pixels=options.pixels, shapes=len(index), lights=len(lights),
         nan_tests=res.stats.nonfinite, hits=int((prov >= 0).sum()), seconds=perf_counter() - start,

@@ -36,6 +36,10 @@ def rgb444_display(rgb565: np.ndarray) -> np.ndarray:
 
 
 def _renderer(options: EmuOptions):
+    if options.mode == "hybrid":
+        from .hybrid import render_frame as hybrid_frame
+
+        return hybrid_frame
     if options.mode == "raster":
         try:
             from .raster import render_frame  # provided by the rasterizer

@@ -28,16 +28,22 @@ def _writes(table: Table, prop: int) -> bool:
 
 @dataclass
 class Scene:
-    """Camera, lights and shapes (or triangles): ``{index: {prop: bits}}``."""
+    """Camera, lights and shapes (or triangles): ``{index: {prop: bits}}``.
+
+    ``objects`` holds what SE/SD pairs write in raytrace and raster mode; in hybrid mode
+    (``docs/isa-extensions.md``) pairs aimed at the triangle table go to ``triangles``.
+    """
 
     camera: dict[int, int] = field(default_factory=dict)
     lights: dict[int, dict[int, int]] = field(default_factory=dict)
     objects: dict[int, dict[int, int]] = field(default_factory=dict)
+    triangles: dict[int, dict[int, int]] = field(default_factory=dict)
 
     def clear(self) -> None:
         self.camera.clear()
         self.lights.clear()
         self.objects.clear()
+        self.triangles.clear()
 
     def set_camera(self, ins: CameraSet) -> None:
         if _writes(Table.CAMERA, ins.prop):
@@ -47,11 +53,15 @@ class Scene:
         if _writes(Table.LIGHT, ins.prop):
             self.lights.setdefault(ins.index, {})[ins.prop] = ins.data
 
-    def set_object(self, ins: ShapeSet, table: Table) -> None:
-        """SE/SD: prop then prop2 (so prop2 wins when both name the same property)."""
+    def set_object(self, ins: ShapeSet, table: Table, store: dict[int, dict[int, int]] | None = None) -> None:
+        """SE/SD: prop then prop2 (so prop2 wins when both name the same property).
+
+        ``store`` is ``objects`` unless given (hybrid mode's ``triangles``).
+        """
+        target = self.objects if store is None else store
         for prop, data in ((ins.prop, ins.data), (ins.prop2, ins.data2)):
             if _writes(table, prop):
-                self.objects.setdefault(ins.index, {})[prop] = data
+                target.setdefault(ins.index, {})[prop] = data
 
     def camera_bits(self, name: str, default: int = 0) -> int:
         return self.camera.get(prop_index(Table.CAMERA, name), default)

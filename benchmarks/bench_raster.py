@@ -4,7 +4,8 @@ Run: ``python benchmarks/bench_raster.py [--runs R] [--precision fp16]``. For ea
 and visibility mode it prints the median wall time per frame over R runs (one directional
 light, flat shading, fp16 ftz by default) beside the original device's figure of about
 1.96 ms per triangle (a whole-screen scan per triangle, paper section V-C1), and the
-ratio device / emulator (above 1: the emulator is faster).
+ratio device / emulator (above 1: the emulator is faster), and the same frame in fp32
+measured in the same run as a baseline for the cost of float16 rounding.
 
 Scenes: a cube (12 triangles) filling about half the screen; a UV sphere of 1,000
 triangles filling about a third of it; 100,000 small random triangles scattered over the
@@ -36,28 +37,42 @@ def scenes() -> list[tuple[str, np.ndarray]]:
     ]
 
 
+def _median_ms(tris, colours, light, view, ar, mode: str, runs: int):
+    times = []
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        res = render_triangles(tris, colours, [light], view, ar, (WIDTH, HEIGHT), mode)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times) * 1e3, res
+
+
+def _setup(ar):
+    view = RasterView(ar.round(np.zeros(3)), None, 1.0, np.inf, (10.0, 7.5))
+    one = ar.const(1.0)
+    light = Light(0, DIRECTIONAL, (ar.const(0.0),) * 3, (ar.const(-0.5), ar.const(-1.0), ar.neg(one)), 0xFFFF, one)
+    return view, light
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=5)
     ap.add_argument("--precision", default="fp16", choices=["fp16", "fp32", "fp64"])
     args = ap.parse_args()
-    ar = make_arith(args.precision)
-    view = RasterView(ar.round(np.zeros(3)), None, 1.0, np.inf, (10.0, 7.5))
-    one = ar.const(1.0)
-    light = Light(0, DIRECTIONAL, (ar.const(0.0),) * 3, (ar.const(-0.5), ar.const(-1.0), ar.neg(one)), 0xFFFF, one)
-    print(f"rasterizer, {WIDTH}x{HEIGHT}, {ar.label}, median of {args.runs} runs per frame")
-    print(f"{'scene':8} {'triangles':>9} {'depth':8} {'emulator ms':>12} {'device ms':>10} {'device/emu':>10} {'fragments':>10}")
+    ar, base = make_arith(args.precision), make_arith("fp32")
+    view, light = _setup(ar)
+    bview, blight = _setup(base)
+    print(f"rasterizer, {WIDTH}x{HEIGHT}, {ar.label}, median of {args.runs} runs per frame; "
+          f"baseline: the same frame in fp32 (no per-operation rounding), measured in this run")
+    print(f"{'scene':8} {'triangles':>9} {'depth':8} {'emulator ms':>12} {'fp32 ms':>8} {'device ms':>10} "
+          f"{'device/emu':>10} {'fragments':>10}")
     for name, tris in scenes():
         colours = (np.arange(len(tris)) * 2654435761 % 65536).astype(np.uint16)
         device_ms = DEVICE_S_PER_TRIANGLE * len(tris) * 1e3
         for mode in ("zbuffer", "painter"):
-            times = []
-            for _ in range(args.runs):
-                t0 = time.perf_counter()
-                res = render_triangles(tris, colours, [light], view, ar, (WIDTH, HEIGHT), mode)
-                times.append(time.perf_counter() - t0)
-            ms = statistics.median(times) * 1e3
-            print(f"{name:8} {len(tris):9d} {mode:8} {ms:12.2f} {device_ms:10.1f} {device_ms / ms:10.1f} {res.stats.fragments:10d}")
+            ms, res = _median_ms(tris, colours, light, view, ar, mode, args.runs)
+            base_ms, _ = _median_ms(tris, colours, blight, bview, base, mode, args.runs)
+            print(f"{name:8} {len(tris):9d} {mode:8} {ms:12.2f} {base_ms:8.2f} {device_ms:10.1f} "
+                  f"{device_ms / ms:10.1f} {res.stats.fragments:10d}")
 
 
 if __name__ == "__main__":

@@ -57,6 +57,7 @@ TOLERANCES: dict[str, Tolerance] = {
     "cylinder_cone": Tolerance(None, 0.063, 30.5, "the cone's shadow edge on the cylinder; terminators"),
     "shadow": Tolerance(None, 0.012, 34.5, "shadow edge"),
     "hybrid": Tolerance(None, 0.011, 34.5, "shadow edges on the floor, the floor's horizon"),
+    "hybrid_mix": Tolerance(40, 0.0075, 35.0, "sphere silhouettes and where the red sphere pierces a triangle"),
     "lights": Tolerance(None, 0.033, 32.0, "terminators of four lights"),
     "transforms": Tolerance(None, 0.065, 31.5, "grazing cone and cylinder edges, shadow edges"),
     "stress4096": Tolerance(40, 0.5, 18.5, "4,096 small spheres: many silhouettes at 64x48"),

@@ -25,17 +25,24 @@ length, each component clamped to |d| >= 2^-10 and mirrored to positive with the
 dir-mask; the root t-values are computed in float64, shifted so that t = 0 is the
 later of the ray start and the root entry (so |t| < 2^12 and nothing can overflow), and
 rounded to 16.16. Results are converted back to the caller's t.
+
+The fixed-point traversal also exists as a compiled per-ray kernel
+(:mod:`rend3r.svo.traverse_jit`, needs numba: ``pip install 'rend3r[fast]'``), bit-identical
+to this one on every output; ``trace(kernel=...)`` chooses.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
 from .fixed import ONE, clamp_direction, to_fixed
 from .octree import Octree, child_table, morton_decode, popcount8
 
+Kernel = Literal["auto", "numba", "numpy"]
+KERNELS: tuple[str, ...] = ("auto", "numba", "numpy")
 _AXIS_BIT = (4, 2, 1)
 #: _SIDE[i, a]: child index i is on the high side of axis a's middle plane
 _SIDE = ((np.arange(8)[:, None] >> np.array([2, 1, 0])) & 1).astype(bool)
@@ -112,19 +119,46 @@ def setup_rays(origin: np.ndarray, direction: np.ndarray):
     return hits, dmask, t0 - shift, t1 - shift, shift, scale
 
 
+def resolve_kernel(kernel: str, fixed: bool = True) -> tuple[str, str | None]:
+    """The traversal ``kernel`` ("auto", "numba", "numpy") runs as: (kernel, note or None).
+
+    "auto" is the compiled numba kernel for fixed point when numba imports, else numpy
+    with a note saying so. The float64 reference always runs on numpy. Raises ValueError
+    for an unknown name, for "numba" with float64, or for "numba" without numba.
+    """
+    if kernel not in KERNELS:
+        raise ValueError(f"unknown traversal kernel {kernel!r} (choose from {', '.join(KERNELS)})")
+    if not fixed:
+        if kernel == "numba":
+            raise ValueError("the numba kernel runs 16.16 fixed point; the float64 reference runs on numpy")
+        return "numpy", None
+    if kernel == "numpy":
+        return "numpy", None
+    try:
+        from . import traverse_jit  # noqa: F401  (imports numba)
+    except ImportError as exc:
+        hint = "pip install 'rend3r[fast]' for the compiled kernel"
+        if kernel == "numba":
+            raise ValueError(f"numba kernel unavailable ({exc}); {hint}") from None
+        return "numpy", f"numba is not available ({exc}): using the numpy traversal (about 10x slower); {hint}"
+    return "numba", None
+
+
 def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: int = 8,
-          fixed: bool = True, record: bool = False) -> TraceResult:
+          fixed: bool = True, record: bool = False, kernel: Kernel = "auto") -> TraceResult:
     """Trace rays ``origin + t * direction`` (octree space, root = [-1, 1]^3).
 
     ``stack_depth`` is the short stack's depth (0 = restart only); when full, a push
     drops the oldest entry. ``fixed`` selects 16.16 arithmetic (else float64). With
     ``record`` the memory requests are returned in ray-major order for cache models.
+    ``kernel`` selects the implementation (see :func:`resolve_kernel`; results are
+    identical).
     """
     if stack_depth < 0:
         raise ValueError("stack depth must be >= 0")
+    use, _ = resolve_kernel(kernel, fixed)
     hits_root, dmask, rt0, rt1, shift, scale = setup_rays(origin, direction)
     n = len(hits_root)
-    words = tree.words.astype(np.int64)
     out = {name: np.zeros(n, dtype=np.int32) for name in
            ("requests", "steps", "descents", "pops", "restarts")}
     out_lvl = np.zeros(n, dtype=np.int8)
@@ -141,9 +175,15 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
         rt0q, rt1q = to_fixed(rt0[:, rid]), to_fixed(rt1[:, rid])
     else:
         rt0q, rt1q = rt0[:, rid].copy(), rt1[:, rid].copy()
-    root_word = int(words[0])
-    root_table = int(child_table(words, np.zeros(1, dtype=np.int64))[0][0])
+    root_table = int(child_table(tree.words, np.zeros(1, dtype=np.int64))[0][0])
     S = stack_depth
+    # a step cap far above any correct traversal; reaching it means a bug, not a hard ray
+    limit = 64 * 8 * (tree.depth + 1) * (1 << min(tree.depth, 12))
+    if use == "numba":
+        return _trace_numba(tree, rid, dmask[rid], rt0q.T, rt1q.T, shift, scale, n, root_table,
+                            S, limit, record)
+    words = tree.words.astype(np.int64)
+    root_word = int(words[0])
     zero_t = 0 if fixed else 0.0
     st = {
         "rid": rid, "dmask": dmask[rid],
@@ -172,7 +212,6 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
         rec_ray.append(rid.copy())
         rec_addr.append(np.zeros(m, dtype=np.int64))
         rec_lvl.append(np.zeros(m, dtype=np.int64))
-    limit = 64 * 8 * (tree.depth + 1) * (1 << min(tree.depth, 12))
 
     def finish(sel: np.ndarray) -> None:
         r = st["rid"][sel]
@@ -345,4 +384,22 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
         result.trace_ray = ray[order]
         result.trace_addr = np.concatenate(rec_addr)[order] if rec_addr else ray
         result.trace_level = np.concatenate(rec_lvl)[order] if rec_lvl else ray
+    return result
+
+
+def _trace_numba(tree: Octree, rid: np.ndarray, dmask: np.ndarray, rt0: np.ndarray, rt1: np.ndarray,
+                 shift: np.ndarray, scale: np.ndarray, n: int, root_table: int, stack_depth: int,
+                 limit: int, record: bool) -> TraceResult:
+    """:func:`trace` on the compiled kernel (fixed point; arguments as prepared there)."""
+    from .traverse_jit import trace_fixed
+
+    (hit, t, axis, code, requests, steps, descents, pops, restarts, max_level, max_stack,
+     rec_ray, rec_addr, rec_lvl) = trace_fixed(tree.words, rid, dmask, rt0, rt1, shift, scale, n,
+                                               root_table, stack_depth, limit, record)
+    voxel = np.full((n, 3), -1, dtype=np.int64)
+    voxel[hit] = morton_decode(code[hit], tree.depth)
+    result = TraceResult(hit, t, axis, voxel, requests, steps, descents, pops, restarts,
+                         max_level, max_stack)
+    if record:
+        result.trace_ray, result.trace_addr, result.trace_level = rec_ray, rec_addr, rec_lvl
     return result

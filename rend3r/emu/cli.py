@@ -94,8 +94,8 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
     for x, y in pixels:
         if not (0 <= x < options.width and 0 <= y < options.height):
             raise Rend3rError(f"--trace-pixel {x},{y} is outside the {options.width}x{options.height} frame")
-    if pixels and options.mode != "raytrace":
-        raise Rend3rError("--trace-pixel traces the raytracer; raster mode has no trace yet (docs/trace.md)")
+    if pixels and options.mode == "hybrid":
+        raise Rend3rError("--trace-pixel traces raytrace or raster mode; hybrid frames have no trace (docs/trace.md)")
     count = execute(loaded.words, options, frames).frames
     if count == 0:
         raise Rend3rError(f"{program}: the program renders no frame (no nf is executed)")
@@ -123,12 +123,13 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
     trace_buf = io.StringIO()
     on_scene = None
     if pixels:
-        from .trace import jsonl_sink, trace_raytrace
+        from .trace import jsonl_sink, trace_raster, trace_raytrace
 
         sink = jsonl_sink(trace_buf)
+        tracer = trace_raster if options.mode == "raster" else trace_raytrace
 
         def on_scene(scene, number: int) -> None:
-            trace_raytrace(scene, options, number, pixels, sink)
+            tracer(scene, options, number, pixels, sink)
 
     try:
         result = run_program(loaded.words, options, frames, on_frame, progress, keep_frames=False, on_scene=on_scene)

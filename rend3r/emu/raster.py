@@ -27,6 +27,7 @@ from ..isa import Table
 from .arith import Arith
 from .camera import VIEW_HEIGHT, VIEW_WIDTH, camera_quaternion, camera_value
 from .frame import Frame
+from .lighting import Recorder
 from .lights import Light, lights_from_scene
 from .options import EmuOptions
 from .raster_clip import ClipPlanes, clip_triangles
@@ -103,8 +104,13 @@ def to_camera(ar: Arith, p: np.ndarray, view: RasterView) -> np.ndarray:
     return np.stack(cam, axis=-1)
 
 
-def project(ar: Arith, v: np.ndarray, view: RasterView, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
-    """Camera-space vertices (..., 3) -> screen coordinates (px, py), device order."""
+def project(
+    ar: Arith, v: np.ndarray, view: RasterView, width: int, height: int, record: Recorder | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Camera-space vertices (..., 3) -> screen coordinates (px, py), device order.
+
+    ``record`` receives ``s.x s.y ndc.x ndc.y px.x px.y`` (pixel traces).
+    """
     near = ar.const(view.near)
     w = ar.neg(v[..., 2])
     sx = ar.div(ar.mul(near, v[..., 0]), w)
@@ -112,7 +118,11 @@ def project(ar: Arith, v: np.ndarray, view: RasterView, width: int, height: int)
     half, one = ar.const(0.5), ar.const(1.0)
     ndc_x = ar.add(ar.div(sx, ar.const(view.canvas[0])), half)
     ndc_y = ar.add(ar.div(sy, ar.const(view.canvas[1])), half)
-    return ar.mul(ndc_x, ar.const(width)), ar.mul(ar.sub(one, ndc_y), ar.const(height))
+    px, py = ar.mul(ndc_x, ar.const(width)), ar.mul(ar.sub(one, ndc_y), ar.const(height))
+    if record is not None:
+        for name, value in (("s.x", sx), ("s.y", sy), ("ndc.x", ndc_x), ("ndc.y", ndc_y), ("px.x", px), ("px.y", py)):
+            record(name, value)
+    return px, py
 
 
 @dataclass(frozen=True)
@@ -133,7 +143,7 @@ def screen_triangles(
 ) -> ScreenTriangles:
     """Clip camera-space triangles (N, 3, 3), project them and snap to the sub-pixel grid."""
     width, height = size
-    clipped = clip_triangles(ar, cam, _clip_planes(ar, view, width, height))
+    clipped = clip_triangles(ar, cam, clip_planes_for(ar, view, width, height))
     one = float(1 << rules.subpixel_bits)
     if clipped.vertices.shape[0]:
         px, py = project(ar, clipped.vertices, view, width, height)
@@ -318,7 +328,7 @@ def render_frame(
     ar = options.arith
     index, tris, colours = triangles_from_scene(scene, ar, options.raster_next_triangle, store)
     lights = lights_from_scene(scene, ar, options.light_model)
-    view = DEVICE_VIEW if options.raster_camera == "device" else view_from_scene(scene, ar)
+    view = frame_view(scene, options)
     rules = DEVICE_RULES if options.raster_rules == "device" else SPEC_RULES
     rules = replace(rules, column_offset=options.raster_column_offset)
     res = render_triangles(
@@ -337,11 +347,16 @@ def render_frame(
     return Frame(number, res.rgb565, res.depth, prov), st
 
 
+def frame_view(scene: Scene, options: EmuOptions) -> RasterView:
+    """The camera the rasterizer uses for this frame: the scene's, or the device's fixed one."""
+    return DEVICE_VIEW if options.raster_camera == "device" else view_from_scene(scene, options.arith)
+
+
 #: The device rasterizer's fixed projection (quirk ``raster-fixed-camera``).
 DEVICE_VIEW = RasterView(np.zeros(3, dtype=np.float32), None, 1.0, np.inf, (VIEW_WIDTH, VIEW_HEIGHT))
 
 
-def _clip_planes(ar: Arith, view: RasterView, width: int, height: int) -> ClipPlanes:
+def clip_planes_for(ar: Arith, view: RasterView, width: int, height: int) -> ClipPlanes:
     # |px - W/2| <= G*W  <=>  |x| / (-z) <= G * canvas_w / near (likewise y).
     g = _GUARD_SCREENS
     return ClipPlanes(

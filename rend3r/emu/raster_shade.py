@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from .arith import Arith
-from .lighting import diffuse
+from .lighting import Recorder, diffuse
 from .lights import Light
 from .vec import Vec
 
@@ -36,10 +36,22 @@ def centroids(ar: Arith, tris: np.ndarray) -> Vec:
 
 
 def flat_colours(
-    ar: Arith, tris: np.ndarray, base: np.ndarray, lights: list[Light], intensity_fixed: bool = False
+    ar: Arith,
+    tris: np.ndarray,
+    base: np.ndarray,
+    lights: list[Light],
+    intensity_fixed: bool = False,
+    record: Recorder | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """RGB565 per triangle, and a mask of triangles whose shading met NaN or infinity."""
+    """RGB565 per triangle, and a mask of triangles whose shading met NaN or infinity.
+
+    ``record`` receives the normal (``n.x n.y n.z``) and the lighting stages.
+    """
+    normal = face_normals(ar, tris)
+    if record is not None:
+        for axis, value in zip("xyz", normal):
+            record(f"n.{axis}", value)
     return diffuse(
-        ar, np.asarray(base, dtype=np.uint16), face_normals(ar, tris), centroids(ar, tris), lights,
-        intensity_fixed=intensity_fixed,
+        ar, np.asarray(base, dtype=np.uint16), normal, centroids(ar, tris), lights,
+        intensity_fixed=intensity_fixed, record=record,
     )

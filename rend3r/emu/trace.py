@@ -117,6 +117,48 @@ def trace_raytrace(scene: Scene, options: EmuOptions, frame: int, pixels: Iterab
         w.put("colour", colour, shown, integer=True)
 
 
+def trace_raster(scene: Scene, options: EmuOptions, frame: int, pixels: Iterable[tuple[int, int]], emit: Emit) -> None:
+    """Emit the records of each pixel of one rasterized frame (``docs/trace.md``).
+
+    Per triangle (index order): its camera-space vertices, their projection steps (for a
+    triangle the near plane or guard band clips, the unclipped vertices' projection, with
+    ``clipped`` = 1), its normal and lighting; then per pixel the frame's ``nearest``,
+    ``depth`` and ``colour``, from the rasterizer's own render of the frame.
+    """
+    from .lights import lights_from_scene
+    from .raster import clip_planes_for, frame_view, render_frame, to_camera, triangles_from_scene, project
+    from .raster_clip import clip_triangles
+    from .raster_shade import flat_colours
+
+    ar = options.arith
+    index, tris, colours = triangles_from_scene(scene, ar, options.raster_next_triangle)
+    lights = lights_from_scene(scene, ar, options.light_model)
+    view = frame_view(scene, options)
+    result, _ = render_frame(scene, options, frame)
+    for x, y in pixels:
+        w = _Writer(ar, emit, frame, (x, y))
+        for k in range(len(index)):
+            idx = int(index[k])
+            one = tris[k : k + 1]
+            cam = to_camera(ar, one, view)
+            for v in range(3):
+                for axis in range(3):
+                    w.put(f"cam.v{v + 1}.{'xyz'[axis]}", cam[0, v, axis], idx)
+            clipped = clip_triangles(ar, cam, clip_planes_for(ar, view, options.width, options.height)).clipped
+            w.put("clipped", clipped, idx, integer=True)
+            for v in range(3):
+                project(ar, cam[0, v : v + 1], view, options.width, options.height,
+                        record=lambda stage, value, v=v: w.put(f"v{v + 1}.{stage}", np.reshape(value, -1)[0], idx))
+            if options.raster_shading:
+                flat_colours(ar, one, colours[k : k + 1], lights, options.intensity_fixed,
+                             record=lambda stage, value: _put_all(w, stage, value, idx))
+        shown = int(result.provenance[y, x])
+        tri = None if shown < 0 else shown
+        w.put("nearest", shown, tri, integer=True)
+        w.put("depth", ar.round(result.depth[y, x]), tri)
+        w.put("colour", int(result.rgb565[y, x]), tri, integer=True)
+
+
 def _put_all(w: _Writer, stage: str, values, shape: int | None) -> None:
     """Record a lighting stage (0-d, or one value per traced point; empty: not reached)."""
     arr = np.asarray(values).reshape(-1)

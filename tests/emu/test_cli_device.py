@@ -101,8 +101,25 @@ def test_trace_to_stdout_and_file_match_the_worked_vector(files):
     (["--trace-pixel", "600,10"], "outside the 512x384 frame"),
     (["--trace-pixel", "1;2"], "expected X,Y"),
     (["--trace", "x.jsonl"], "needs at least one --trace-pixel"),
-    (["--trace-pixel", "1,2", "--mode", "raster"], "raster mode has no trace"),
+    (["--trace-pixel", "1,2", "--mode", "hybrid"], "hybrid frames have no trace"),
 ])
 def test_trace_option_errors(files, args, message):
     r = _run(files / "sphere.asm", "-o", files / "e.png", *args)
     assert r.exit_code == 1 and message in r.output, r.output
+
+
+def test_raster_trace_lists_projection_steps_and_the_frame_pixel(files):
+    r = _run(files / "tris.asm", "-o", files / "r.png", "--size", "40x30", "--trace-pixel", "20,15",
+             "--provenance", files / "r.npy")
+    assert r.exit_code == 0, r.output
+    recs = [json.loads(line) for line in r.output.splitlines()]
+    stages = [x["stage"] for x in recs if x["shape"] == 0]
+    assert stages[:3] == ["cam.v1.x", "cam.v1.y", "cam.v1.z"] and "v3.px.y" in stages and "n.z" in stages
+    last = {x["stage"]: x for x in recs if x["shape"] is None or x["stage"] in ("nearest", "colour", "depth")}
+    assert last["nearest"]["dec"] == int(np.load(files / "r.npy")[15, 20])
+    px = [x for x in recs if x["shape"] == 0 and x["stage"] == "v1.px.x"][0]
+    # v1 = (-2, -1, -3): s = 1*(-2)/3, ndc = s/(10*0.2) + 0.5, px = ndc*40, each rounded to float16
+    h = np.float16
+    s = h(h(h(1) * h(-2)) / h(3))
+    want = h(h(h(s / h(2.0)) + h(0.5)) * h(40))
+    assert px["dec"] == float(want)

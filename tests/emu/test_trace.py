@@ -1,12 +1,9 @@
 """Pixel traces: the worked device vectors, agreement with the frame, the JSON schema."""
 
 import io
-import json
 
 import numpy as np
-from click.testing import CliRunner
 
-from rend3r.cli import main
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.processor import execute
 from rend3r.emu.raytracer import render_frame

@@ -1,0 +1,300 @@
+"""cocotb tests of rend3r_loader against rend3r's own transport code (run by tests/firmware).
+
+Frames are built with rend3r.transport, replies are decoded with it and compared byte for
+byte with the reference receiver (rend3r.transport.device.DeviceCore), and the instruction
+memory is read back through the processor's port.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+from pathlib import Path
+
+import cocotb
+from cocotb.clock import Clock
+from cocotb.triggers import ClockCycles
+
+from rend3r.transport.device import DeviceCore
+from rend3r.transport.protocol import (
+    LIMIT, PROGRAM_INFO, Frame, FrameType, Nack, Status, program_crc, words_to_bytes,
+)
+from rend3r.transport.session import load_frames
+
+from sim_links import DEVICE_MAC, Pins, eth_for, serial_bytes, wire_bytes
+
+REPO = Path(__file__).resolve().parents[2]
+AW = int(os.environ.get("LOADER_AW", "10"))
+CPB = int(os.environ.get("LOADER_CPB", "16"))
+RETRYABLE = {Nack.NO_LOAD, Nack.OUT_OF_RANGE, Nack.MISMATCH}
+
+
+def assembled(name: str) -> list[int]:
+    """The words the assembler makes of programs/<name>.asm."""
+    from rend3r.transport.cli import read_program
+
+    return list(read_program(str(REPO / "programs" / name)).words)
+
+
+async def bring_up(dut) -> Pins:
+    """Clock, reset, idle lines, monitors."""
+    cocotb.start_soon(Clock(dut.clk, 20, unit="ns").start())  # 50 MHz
+    cocotb.start_soon(Clock(dut.prog_clk, 10, unit="ns").start())  # the processor's 100 MHz
+    dut.rst.value = 1
+    dut.rmii_crs_dv.value = 0
+    dut.rmii_rxd.value = 0
+    dut.uart_rx.value = 1
+    dut.prog_addr.value = 0
+    dut.frames_rendered.value = 0
+    await ClockCycles(dut.clk, 4)
+    dut.rst.value = 0
+    await ClockCycles(dut.clk, 4)
+    pins = Pins(dut, CPB)
+    pins.start_monitors()
+    return pins
+
+
+class Sender:
+    """Stop-and-wait sender over one link, with optional drops and corruption."""
+
+    def __init__(self, pins: Pins, link: str, rng: random.Random,
+                 drop: float = 0.0, corrupt: float = 0.0) -> None:
+        self.pins, self.link, self.rng = pins, link, rng
+        self.drop, self.corrupt = drop, corrupt
+        self.corrupted = self.dropped = 0
+        words_time = 1 << AW  # a COMMIT's CRC pass over the whole bank, at most
+        self.timeout = words_time + (600 if link == "rmii" else 60 * 10 * CPB)
+
+    async def put(self, frame: bytes, mangle: bool = False) -> None:
+        """Send one protocol frame; ``mangle`` flips one byte on the wire after framing."""
+        if self.link == "rmii":
+            wire = bytearray(wire_bytes(eth_for(frame)))
+            lo, hi = 8 + 14, len(wire) - 4  # payload bytes: a bad FCS, not a filtered frame
+        else:
+            wire = bytearray(serial_bytes(frame))
+            lo, hi = 0, len(wire) - 1  # never the delimiter
+        if mangle:
+            i = self.rng.randrange(lo, hi)
+            flip = self.rng.choice([x for x in (1, 2, 4, 8, 16, 32, 64, 128) if x != wire[i]])
+            wire[i] ^= flip
+        if self.link == "rmii":
+            await self.pins.send_rmii(bytes(wire))
+        else:
+            await self.pins.send_uart(bytes(wire))
+
+    async def reply_to(self, f: Frame) -> Frame | None:
+        """The reply matching ``f`` (load, seq, ref), or None after the timeout."""
+        for _ in range(self.timeout // 16):
+            for r in self.pins.replies:
+                if (r.load, r.seq, r.ref) == (f.load, f.seq, f.type):
+                    self.pins.replies.remove(r)
+                    return r
+            await ClockCycles(self.pins.dut.clk, 16)
+        return None
+
+    async def request(self, f: Frame, tries: int = 10) -> Frame:
+        """Send ``f`` until it is answered, injecting the configured faults."""
+        for _ in range(tries):
+            fate = self.rng.random()
+            if fate < self.drop:
+                self.dropped += 1
+                continue  # lost on the way: the sender would time out and resend
+            mangle = fate < self.drop + self.corrupt
+            self.corrupted += mangle
+            await self.put(f.encode(), mangle)
+            reply = await self.reply_to(f)
+            if reply is not None:
+                return reply
+        raise AssertionError(f"no reply to {FrameType(f.type).name} seq {f.seq} after {tries} tries")
+
+    async def load(self, words: list[int], chunk: int = 256) -> int:
+        """Load ``words`` like rend3r send (restarting on NO_LOAD/OUT_OF_RANGE/MISMATCH)."""
+        for attempt in range(8):
+            frames = load_frames(words, self.rng.randrange(1, 1 << 16), self.rng.randrange(1 << 16), chunk)
+            for f in frames:
+                r = await self.request(f)
+                if r.type == FrameType.NACK:
+                    assert r.code in RETRYABLE, f"fatal NACK {Nack(r.code).name}"
+                    break
+            else:
+                return attempt
+        raise AssertionError("load did not complete in 8 attempts")
+
+    async def status(self) -> Status:
+        r = await self.request(Frame(FrameType.STATUS, 0, self.rng.randrange(1 << 16)))
+        assert r.type == FrameType.ACK
+        return Status.unpack(r.payload)
+
+
+async def check_loaded(pins: Pins, sender: Sender, words: list[int]) -> None:
+    """Memory holds ``words`` (zeros after them) and STATUS reports their length and CRC."""
+    span = min(len(words) + 8, 1 << AW)
+    got = await pins.read_memory(span)
+    assert got == (words + [0] * span)[:span]
+    st = await sender.status()
+    assert (st.words, st.crc) == (len(words), program_crc(words))
+    assert pins.bad_replies == 0
+
+
+@cocotb.test()
+async def uart_load_assembled(dut):
+    """An assembled program over UART/COBS lands word for word; ACKs decode."""
+    pins = await bring_up(dut)
+    sender = Sender(pins, "uart", random.Random(1))
+    words = assembled("sphere.asm")
+    assert await sender.load(words, chunk=8) == 0
+    await check_loaded(pins, sender, words)
+    st = await sender.status()
+    assert (st.loads, st.malformed, st.staging, st.running) == (1, 0, False, True)
+
+
+@cocotb.test()
+async def uart_faults(dut):
+    """Corrupted and dropped serial frames: the load still completes exactly."""
+    pins = await bring_up(dut)
+    sender = Sender(pins, "uart", random.Random(2), drop=0.15, corrupt=0.2)
+    words = assembled("shadow.asm")
+    await sender.load(words, chunk=4)
+    assert sender.corrupted and sender.dropped
+    sender.drop = sender.corrupt = 0.0
+    await check_loaded(pins, sender, words)
+    st = await sender.status()
+    assert st.malformed == sender.corrupted
+
+
+@cocotb.test()
+async def rmii_faults_and_atomicity(dut):
+    """RMII loads with faults; partial and mismatching loads leave the program untouched."""
+    pins = await bring_up(dut)
+    rng = random.Random(3)
+    sender = Sender(pins, "rmii", rng, drop=0.15, corrupt=0.2)
+    first = assembled("camera.asm")
+    await sender.load(first, chunk=16)
+    assert sender.corrupted and sender.dropped
+    sender.drop = sender.corrupt = 0.0
+    await check_loaded(pins, sender, first)
+    st = await sender.status()
+    assert st.malformed == sender.corrupted
+
+    # a partial load (BEGIN and half the DATA, never committed)
+    second = assembled("lights.asm")
+    frames = load_frames(second, 0x4242, 100, 8)
+    for f in frames[: len(frames) // 2]:
+        assert (await sender.request(f)).type == FrameType.ACK
+    await check_loaded(pins, sender, first)
+    assert (await sender.status()).staging
+
+    # a complete load whose DATA carries a wrong word: COMMIT is refused
+    frames = load_frames(second, 0x4343, 200, 8)
+    bad = list(second)
+    bad[5] ^= 0x10
+    tampered = load_frames(bad, 0x4343, 200, 8)[1]
+    for f in [frames[0], tampered, *frames[2:-1]]:
+        assert (await sender.request(f)).type == FrameType.ACK
+    r = await sender.request(frames[-1])
+    assert (r.type, r.code) == (FrameType.NACK, Nack.MISMATCH)
+    await check_loaded(pins, sender, first)
+
+    # resending the good DATA frame repairs the staged words; COMMIT then succeeds
+    assert (await sender.request(frames[1])).type == FrameType.ACK
+    assert (await sender.request(frames[-1])).type == FrameType.ACK
+    await check_loaded(pins, sender, second)
+
+
+@cocotb.test()
+async def rmii_filters(dut):
+    """Other MACs and EtherTypes are ignored, broadcast is accepted, bad FCS is counted."""
+    pins = await bring_up(dut)
+    sender = Sender(pins, "rmii", random.Random(4))
+    st = Frame(FrameType.STATUS, 0, 7).encode()
+    await pins.send_rmii(wire_bytes(eth_for(st, dst=bytes.fromhex("69695a065492"))))
+    await pins.send_rmii(wire_bytes(eth_for(st, ethertype=0x0800)))
+    await ClockCycles(dut.clk, 800)
+    assert pins.replies == []
+    broken = bytearray(wire_bytes(eth_for(st)))
+    broken[-1] ^= 1  # FCS
+    await pins.send_rmii(bytes(broken))
+    await ClockCycles(dut.clk, 800)
+    assert pins.replies == []
+    await pins.send_rmii(wire_bytes(eth_for(st, dst=b"\xff" * 6)))
+    r = await sender.reply_to(Frame(FrameType.STATUS, 0, 7))
+    assert r is not None and Status.unpack(r.payload).malformed == 1
+    assert DEVICE_MAC == bytes.fromhex("69695a065491")
+
+
+def reference_script(rng: random.Random) -> list[Frame]:
+    """Requests covering every reply the protocol defines, in one sequence."""
+    prog = [rng.randrange(1 << 32) for _ in range(20)]
+    info = PROGRAM_INFO.pack(len(prog), program_crc(prog))
+    too_big = PROGRAM_INFO.pack((1 << AW) + 1, 0)
+    load = load_frames(prog, 0x0101, 10, 8)
+    other = load_frames(prog[:4], 0x0202, 50, 8)
+    return [
+        Frame(FrameType.STATUS, 0, 1),
+        Frame(FrameType.STATUS, 0, 2, version=2),                           # BAD_VERSION
+        Frame(0x09, 0, 3),                                                  # BAD_TYPE
+        Frame(FrameType.RUN, 0, 4, count=1),                                # BAD_FIELDS
+        Frame(FrameType.BEGIN, 9, 5, payload=too_big),                      # TOO_LARGE
+        Frame(FrameType.BEGIN, 9, 6, payload=info[:4]),                     # BAD_FIELDS
+        Frame(FrameType.DATA, 9, 7, 0, 1, words_to_bytes(prog[:1])),        # NO_LOAD
+        Frame(FrameType.COMMIT, 9, 8, payload=info),                        # NO_LOAD
+        load[0], load[0],                                                   # repeated BEGIN
+        Frame(FrameType.DATA, 0x0101, 11, 16, 8, words_to_bytes(prog[:8])),  # OUT_OF_RANGE
+        Frame(FrameType.DATA, 0x0101, 12, 0, 2, words_to_bytes(prog[:1])),  # BAD_FIELDS
+        Frame(FrameType.DATA, 0x0101, 12, 0, 0),                            # BAD_FIELDS
+        *load[1:3], Frame(FrameType.STATUS, 0, 13),                         # staging open
+        load[-1],                                                           # MISMATCH (missing DATA)
+        load[3], load[-1], load[-1], load[1], load[0],                      # commit, late duplicates
+        Frame(FrameType.STATUS, 0, 14),
+        Frame(FrameType.ACK, 0, 15),                                        # ignored
+        Frame(FrameType.STOP, 0, 16), Frame(FrameType.STATUS, 0, 17),
+        other[0], other[1], load[1],                                        # NO_LOAD: stale load
+        Frame(FrameType.RUN, 0, 18), Frame(FrameType.RESET, 0, 19),
+        Frame(FrameType.STATUS, 0, 20),
+    ]
+
+
+@cocotb.test()
+async def replies_match_reference(dut):
+    """Every reply equals DeviceCore's byte for byte, on both links; RESET zeroes memory."""
+    pins = await bring_up(dut)
+    rng = random.Random(5)
+    core = DeviceCore(max_words=1 << AW)
+    script = reference_script(rng)
+    for i, f in enumerate(script):
+        link = "uart" if i % 3 == 0 else "rmii"
+        sender = Sender(pins, link, rng)
+        data = f.encode()
+        expected = core.handle(data)
+        await sender.put(data)
+        if expected is None:
+            await ClockCycles(dut.clk, sender.timeout)
+            assert pins.replies == [], f"step {i}: unexpected reply"
+            continue
+        got = await sender.reply_to(Frame(f.type, f.load, f.seq))
+        assert got is not None, f"step {i}: no reply to {f}"
+        assert got.encode() == expected, f"step {i}: {got} != reference"
+    assert await pins.read_memory(8) == [0] * 8
+    assert pins.bad_replies == 0
+    assert LIMIT.size == 4
+
+
+@cocotb.test()
+async def rmii_back_to_back(dut):
+    """A long assembled program at line rate: no frame lost, every frame ACKed once."""
+    pins = await bring_up(dut)
+    rng = random.Random(6)
+    words = assembled("tri_sphere.asm")[: 1 << AW]
+    frames = load_frames(words, 0x7777, 1000)
+    sender = Sender(pins, "rmii", rng)
+    start = cocotb.utils.get_sim_time("ns")
+    for f in frames[:-1]:
+        await sender.put(f.encode())  # minimum inter-frame gap, no waiting for ACKs
+    await ClockCycles(dut.clk, 400)
+    acked = {r.seq for r in pins.replies if r.type == FrameType.ACK}
+    assert acked == {f.seq for f in frames[:-1]}
+    pins.replies.clear()
+    r = await sender.request(frames[-1])
+    assert r.type == FrameType.ACK
+    dut._log.info("loaded %d words in %d ns", len(words), cocotb.utils.get_sim_time("ns") - start)
+    await check_loaded(pins, sender, words)

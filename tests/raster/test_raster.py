@@ -108,10 +108,11 @@ def test_far_clip_drops_fragments_beyond_it():
 @settings(max_examples=15)
 @given(
     st.floats(-0.8, 0.8), st.floats(-0.8, 0.8), st.floats(-0.8, 0.8),
-    st.floats(0.6, 1.6), st.floats(0.6, 1.6), st.floats(0.5, 2.0),
+    st.floats(0.6, 1.6), st.floats(0.6, 1.6), st.floats(0.5, 2.0), st.booleans(),
 )
-def test_coverage_matches_the_raytracers_camera_rays(qi, qj, px, hfov, vfov, near):
-    """Pixels whose spec-camera ray hits the triangle well inside are covered, well outside not."""
+def test_coverage_matches_the_raytracers_camera_rays(qi, qj, px, hfov, vfov, near, crossing):
+    """Pixels whose spec-camera ray hits the triangle well inside (and well beyond the near
+    plane) are covered; well outside, or well before the near plane, not."""
     ar = make_arith("fp32")
     scene = Scene()
     for name, value in (("rrot", 1.0), ("irot", qi * 0.3), ("jrot", qj * 0.3), ("xloc", px),
@@ -120,6 +121,8 @@ def test_coverage_matches_the_raytracers_camera_rays(qi, qj, px, hfov, vfov, nea
     opts = EmuOptions(precision="fp32", width=W, height=H)
     rays = camera_rays(scene, opts, ar)
     tri = np.array([[-3.0, -2.0, -6.0], [4.0, -1.0, -7.0], [0.5, 3.0, -5.0]])
+    if crossing:  # one vertex close to the eye: the near plane cuts the triangle
+        tri[2] = (0.3, 0.4, -0.2)
     r = rasterize(tri[None], np.array([RED]), view_from_scene(scene, ar), ar, (W, H))
     o = np.array([float(c) for c in rays.origin])
     d = np.stack([np.broadcast_to(c, (W * H,)) for c in rays.direction], axis=1).astype(np.float64)
@@ -131,9 +134,12 @@ def test_coverage_matches_the_raytracers_camera_rays(qi, qj, px, hfov, vfov, nea
     m = np.linalg.inv(np.stack([e1, e2, n], axis=1))
     b = p @ m.T
     bary = np.stack([1 - b[:, 0] - b[:, 1], b[:, 0], b[:, 1]], axis=1).min(axis=1)
+    assert r.stats.clipped == int(crossing)
     covered = (r.provenance >= 0).reshape(-1)
-    assert covered[bary > 0.04].all()
-    assert not covered[bary < -0.04].any()
+    # Camera depth -z of each ray's hit: t along the spec ray, whose t = 1 is the near plane.
+    depth = t * float(view_from_scene(scene, ar).near)
+    assert covered[(bary > 0.04) & (depth > 1.15 * near)].all()
+    assert not covered[(bary < -0.04) | (depth < 0.85 * near)].any()
 
 
 def _light(ar, forward):

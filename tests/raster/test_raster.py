@@ -208,3 +208,17 @@ def test_run_program_renders_triangles_in_raster_mode():
     assert frame.provenance[2, W // 2] == 0 and frame.rgb565[2, W // 2] == RED
     assert frame.depth[H // 2, W // 2] == pytest.approx(2.0 * np.sqrt(1 + 2 * 0.125**2), rel=1e-3)
     assert res.stats.frames[0].hits == (frame.provenance >= 0).sum()
+
+
+@settings(max_examples=40)
+@given(st.lists(st.integers(0, 0xFFFF), min_size=9, max_size=27), st.sampled_from(["zbuffer", "painter"]))
+def test_any_float16_vertices_give_a_defined_frame(bits, depth_mode):
+    """Infinities, NaNs, subnormals, huge and degenerate triangles: no exception, no NaN pixel."""
+    ar = make_arith("fp16")
+    n = len(bits) // 9
+    tris = ar.from_bits(np.array(bits[: n * 9], dtype=np.uint16)).reshape(n, 3, 3)
+    light = _light(ar, (0.3, -0.5, -1.0))
+    r = render_triangles(tris, np.arange(n) * 0x1111, [light], view(ar), ar, (16, 12), depth_mode)
+    hit = r.provenance >= 0
+    assert np.isfinite(r.depth[hit]).all() and (r.depth[hit] > 0).all()
+    assert np.isinf(r.depth[~hit]).all() and (r.rgb565[~hit] == 0).all()

@@ -94,6 +94,19 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
                f"({tree.far_count()} far pointers), {time.perf_counter() - start:.2f} s")
 
 
+def _kernel(kernel: str, fixed: bool) -> str:
+    """The traversal kernel to run; prints a note on stderr when auto falls back to numpy."""
+    from .traverse import resolve_kernel
+
+    try:
+        use, note = resolve_kernel(kernel, fixed)
+    except ValueError as exc:
+        raise Rend3rError(str(exc)) from None
+    if note:
+        click.echo(f"note: {note}", err=True)
+    return use
+
+
 def _place(value: str | None):
     if value is None:
         return None
@@ -114,6 +127,9 @@ def _place(value: str | None):
 @click.option("--stack", type=click.IntRange(0, 64), default=8, show_default=True,
               help="Short-stack depth (0 = restart only).")
 @click.option("--float", "use_float", is_flag=True, help="float64 reference instead of 16.16.")
+@click.option("--kernel", type=click.Choice(["auto", "numba", "numpy"]), default="auto", show_default=True,
+              help="Traversal: compiled numba kernel (pip install 'rend3r[fast]') or numpy; "
+                   "auto = numba if installed. Identical results.")
 @click.option("--azimuth", type=float, default=35.0, show_default=True)
 @click.option("--elevation", type=float, default=25.0, show_default=True)
 @click.option("--distance", type=click.FloatRange(min=0.1), default=1.6, show_default=True,
@@ -123,7 +139,7 @@ def _place(value: str | None):
 @click.option("--with-program", "program", default=None, type=click.Path(dir_okay=False),
               help="Merge into the frames of this REND3R program (its camera is used).")
 @click.option("--place", default=None, help="With --with-program: model centre and half size X,Y,Z,S.")
-def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: bool,
+def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: bool, kernel: str,
                azimuth: float, elevation: float, distance: float, cost_path: str | None,
                show_stats: bool, program: str | None, place: str | None) -> None:
     """Trace MODEL.svo and write an image (depth or shaded)."""
@@ -133,12 +149,14 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
     from .fileformat import read_svo
     from .render import cost_image, render
 
+    kernel = _kernel(kernel, not use_float)
     svo = read_svo(model)
     if program is not None:
         from .hybrid import program_hybrid, rgb565_to_888
 
         bounds = _place(place) or svo.bounds
-        frames = program_hybrid(svo, program, model_matrix(bounds), size[0], size[1], stack)
+        frames = program_hybrid(svo, program, model_matrix(bounds), size[0], size[1], stack,
+                                kernel=kernel)
         if not frames:
             raise Rend3rError(f"{program}: the program renders no frame")
         Image.fromarray(rgb565_to_888(frames[0][0])).save(output)
@@ -148,7 +166,7 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
         raise Rend3rError("--place needs --with-program")
     cam = orbit_camera(svo.bounds, azimuth, elevation, distance, size[0], size[1])
     start = time.perf_counter()
-    r = render(svo, cam, stack, not use_float, mode)
+    r = render(svo, cam, stack, not use_float, mode, kernel=kernel)
     elapsed = time.perf_counter() - start
     Image.fromarray(r.rgb).save(output)
     if cost_path:
@@ -176,6 +194,7 @@ def sweep_cmd(model: str, output: str, size, views: int, jobs: int) -> None:
     from .fileformat import read_svo
     from .sweep import run_sweep, thesis_points, to_csv, to_markdown
 
+    _kernel("auto", True)
     svo = read_svo(model)
     start = time.perf_counter()
     rows = run_sweep(svo, thesis_points(), size[0], size[1], views, jobs)

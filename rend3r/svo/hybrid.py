@@ -71,7 +71,8 @@ def merge(svo_rgb565: np.ndarray, svo_dist: np.ndarray, frame_rgb565: np.ndarray
 
 
 def program_hybrid(model, program: str, model_matrix: np.ndarray, width: int, height: int,
-                   stack_depth: int = 8, frames: int = 1) -> list[tuple[np.ndarray, np.ndarray]]:
+                   stack_depth: int = 8, frames: int = 1, kernel: str = "auto"
+                   ) -> list[tuple[np.ndarray, np.ndarray]]:
     """Run a REND3R program in the emulator and merge the SVO into each of its frames.
 
     The SVO is traced with the emulator's own primary rays for the frame (same camera),
@@ -105,7 +106,7 @@ def program_hybrid(model, program: str, model_matrix: np.ndarray, width: int, he
             raise Rend3rError(f"{program}: frame {frame.number}: the camera produces non-finite or zero rays")
         o_oct = inv[:3, :3] @ o + inv[:3, 3]
         d_oct = d @ inv[:3, :3].T
-        res = trace(model.tree, np.broadcast_to(o_oct, d.shape), d_oct, stack_depth)
+        res = trace(model.tree, np.broadcast_to(o_oct, d.shape), d_oct, stack_depth, kernel=kernel)
         dist = np.where(res.hit, res.t * np.linalg.norm(d, axis=1), np.inf)
         rgb = shade(res, d_oct, dist, "shaded", height, width)
         out.append(merge(rgb888_to_565(rgb), dist.reshape(height, width).astype(np.float32),

@@ -8,7 +8,7 @@ import numpy as np
 
 from .camera import Camera, PrimaryRays, model_matrix, primary_rays, t_to_distance, t_to_ndc_z
 from .fileformat import SvoModel
-from .traverse import TraceResult, trace
+from .traverse import Kernel, TraceResult, trace
 
 
 @dataclass
@@ -49,10 +49,13 @@ def shade(result: TraceResult, direction: np.ndarray, dist: np.ndarray, mode: st
 
 
 def render(model: SvoModel, cam: Camera, stack_depth: int = 8, fixed: bool = True,
-           mode: str = "shaded", record: bool = False) -> Render:
-    """Trace one frame; hits beyond the far plane (t > 1) count as misses."""
+           mode: str = "shaded", record: bool = False, kernel: Kernel = "auto") -> Render:
+    """Trace one frame; hits beyond the far plane (t > 1) count as misses.
+
+    ``kernel``: traversal implementation (:func:`rend3r.svo.traverse.resolve_kernel`).
+    """
     rays = primary_rays(cam, model_matrix(model.bounds))
-    res = trace(model.tree, rays.origin, rays.direction, stack_depth, fixed, record)
+    res = trace(model.tree, rays.origin, rays.direction, stack_depth, fixed, record, kernel)
     beyond = res.hit & (res.t > 1.0)
     res.hit[beyond] = False
     res.t[beyond] = np.inf

@@ -33,6 +33,7 @@ to this one on every output; ``trace(kernel=...)`` chooses.
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass
 from typing import Literal
 
@@ -135,7 +136,7 @@ def resolve_kernel(kernel: str, fixed: bool = True) -> tuple[str, str | None]:
     if kernel == "numpy":
         return "numpy", None
     try:
-        from . import traverse_jit  # noqa: F401  (imports numba)
+        importlib.import_module(".traverse_jit", __package__)  # imports numba
     except ImportError as exc:
         hint = "pip install 'rend3r[fast]' for the compiled kernel"
         if kernel == "numba":

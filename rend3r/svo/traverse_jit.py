@@ -7,22 +7,27 @@ check that. Importing this module imports numba: :func:`rend3r.svo.traverse.trac
 it only when the numba kernel is selected. Ray setup (normalisation, clamping, dir-mask,
 root t-values) stays in numpy and is shared with the numpy path.
 
-The kernel is compiled on first use (a few seconds, once per process; no disk cache, so
-nothing is written next to the package).
+The kernel is compiled on first use (several seconds). Numba caches the machine code on
+disk (``__pycache__`` next to this file, or numba's per-user cache directory when that is
+not writable) so later processes load it in well under a second; set
+``REND3R_JIT_CACHE=0`` to compile in memory only (the tests do).
 """
 
 from __future__ import annotations
+
+import os
 
 import numpy as np
 from numba import njit
 
 from .fixed import ONE
 
+_CACHE = os.environ.get("REND3R_JIT_CACHE", "1") != "0"
 #: initial trace capacity per ray (grown by doubling when a frame needs more)
 _TRACE_PER_RAY = 24
 
 
-@njit(cache=False, nogil=True)
+@njit(cache=_CACHE, nogil=True)
 def _first_index(t00, t01, t02, t10, t11, t12):
     """FIRSTINDEX(t_enter, t_m): bit a set where the entry lies beyond the middle plane."""
     enter = max(max(t00, t01), t02)
@@ -36,7 +41,7 @@ def _first_index(t00, t01, t02, t10, t11, t12):
     return idx
 
 
-@njit(cache=False, nogil=True)
+@njit(cache=_CACHE, nogil=True)
 def _popcount8(x):
     x = x & 0xFF
     x = x - ((x >> 1) & 0x55)
@@ -44,7 +49,7 @@ def _popcount8(x):
     return (x + (x >> 4)) & 0x0F
 
 
-@njit(cache=False, nogil=True)
+@njit(cache=_CACHE, nogil=True)
 def _grow(buf, need):
     if need <= buf.shape[0]:
         return buf
@@ -53,7 +58,7 @@ def _grow(buf, need):
     return out
 
 
-@njit(cache=False, nogil=True)
+@njit(cache=_CACHE, nogil=True)
 def _kernel(words, rid, dmask, rt0, rt1, shift, scale, n, root_table, stack_depth, limit, record):
     """Trace rays ``rid`` (those that hit the root) through ``words``; see :func:`trace_fixed`."""
     m = rid.shape[0]

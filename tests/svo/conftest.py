@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 
@@ -35,3 +37,7 @@ def brute_force(coords: np.ndarray, depth: int, origin: np.ndarray, direction: n
 def small_tree():
     coords = random_voxels(5, 600, 7)
     return coords, build_octree(coords, 5)
+
+
+# compile the numba kernel in memory only: the tests write nothing next to the package
+os.environ.setdefault("REND3R_JIT_CACHE", "0")

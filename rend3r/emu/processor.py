@@ -14,7 +14,7 @@ from typing import Callable, Sequence
 from ..errors import Rend3rError
 from ..isa import CameraSet, FrameOp, Func, LightSet, ShapeSet, Table, TrailingSE, Unknown, decode_word
 from ..isa.tables import OPCODE, Opcode
-from .isa_ext import decode_table_select
+from ..isa.extensions import decode_table_select
 from .options import EmuOptions
 from .scene import Scene
 

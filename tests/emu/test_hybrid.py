@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from rend3r.emu.hybrid import TRIANGLE_BASE
-from rend3r.emu.isa_ext import decode_table_select, table_select_word
+from rend3r.isa.extensions import decode_table_select, table_select_word
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.run import run_program
 from rend3r.errors import Rend3rError

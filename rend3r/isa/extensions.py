@@ -8,8 +8,7 @@ accepts it.
 
 from __future__ import annotations
 
-from ..isa import Table
-from ..isa.tables import Field
+from .tables import Field, Table
 
 TS_OPCODE = 0b010
 TS_TABLE = Field(4, 3)

@@ -48,7 +48,8 @@ def _colour(ctx, param, value: str) -> int:
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormals: flush to zero (the device's IP) or IEEE gradual underflow.")
 @click.option("--size", default="512x384", show_default=True, callback=_size, help="Image size WxH.")
 @click.option("--background", default="0x0000", show_default=True, callback=_colour, help="RGB565 colour where no shape is hit.")
-@click.option("--depth", "depth", help="Raster visibility: zbuffer (default) or painter. Any other value is taken as --depth-image FILE.")
+@click.option("--depth", "visibility", type=click.Choice(["zbuffer", "painter"]), default="zbuffer", show_default=True,
+              help="Raster visibility: a depth buffer, or the paper's painter order by centroid distance.")
 @click.option("--depth-image", "depth_path", help="Depth image per frame: .npy (float32 distances) or 16-bit PNG.")
 @click.option("--provenance", "prov_path", help="Which shape made each pixel: .npy (int32, -1 none) or PNG.")
 @click.option("--gif", "gif_path", help="All frames as an animated GIF.")
@@ -58,7 +59,7 @@ def _colour(ctx, param, value: str) -> int:
 @click.option("--device-quirk", "quirks", multiple=True, metavar="NAME", help="Switch on one device quirk (repeatable); names in docs/device-profile.md.")
 @click.option("--trace-pixel", "trace_pixels", multiple=True, metavar="X,Y", help="Trace every float16 intermediate of this pixel (repeatable; docs/trace.md).")
 @click.option("--trace", "trace_path", help="Write pixel traces (JSON lines) to FILE instead of standard output.")
-def emulate_command(program, output, frames, mode, precision, subnormals, size, background, depth,
+def emulate_command(program, output, frames, mode, precision, subnormals, size, background, visibility,
                     depth_path, prov_path, gif_path, apng_path, show_stats, profile, quirks, trace_pixels,
                     trace_path) -> None:
     """Run a REND3R PROGRAM (source or memory image) and render its frames."""
@@ -74,13 +75,6 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
         raise Rend3rError("--gif and --apng are exclusive: choose one animation format")
     if not (output or gif_path or apng_path):
         raise Rend3rError("nothing to write: give -o OUT (and/or --gif/--apng)")
-    visibility = "zbuffer"
-    if depth in ("zbuffer", "painter"):
-        visibility = depth
-    elif depth is not None:
-        if depth_path:
-            raise Rend3rError("--depth FILE and --depth-image FILE both name a depth image: give one")
-        depth_path = depth
     try:
         pixels = [parse_pixel(p) for p in trace_pixels]
     except ValueError as exc:

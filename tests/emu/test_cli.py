@@ -73,7 +73,7 @@ def test_several_frames_need_a_pattern_then_write_each_and_a_gif(tmp_path):
     anim.write_text("nr\nsp 0, type, zloc, 1, -3\nsp 0, xscl, yscl, 1, 1\nsp 0, zscl, col, 1, 0xffff\nnf\n"
                     "sp 0, xloc, zero, 1, 0\nnf\nsp 0, xloc, zero, 2, 0\nnf\ner\n")
     r = _run(anim, "-o", tmp_path / "out" / "f_{n:02}.png", "--gif", tmp_path / "a.gif",
-             "--depth", tmp_path / "d_{n}.npy", "--provenance", tmp_path / "p_{n}.png", "--size", "16x12")
+             "--depth-image", tmp_path / "d_{n}.npy", "--provenance", tmp_path / "p_{n}.png", "--size", "16x12")
     assert r.exit_code == 0, r.output
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["f_00.png", "f_01.png", "f_02.png"]
     gif = Image.open(tmp_path / "a.gif")
@@ -84,7 +84,7 @@ def test_several_frames_need_a_pattern_then_write_each_and_a_gif(tmp_path):
 
 
 def test_apng_depth_png_and_stats(tmp_path, src):
-    r = _run(src, "--apng", tmp_path / "a.png", "--depth", tmp_path / "d.png", "--provenance",
+    r = _run(src, "--apng", tmp_path / "a.png", "--depth-image", tmp_path / "d.png", "--provenance",
              tmp_path / "p.npy", "--stats", "--size", "32x24", "--precision", "fp32")
     assert r.exit_code == 0, r.output
     assert "device estimate" in r.output and "rays 768" in r.output

@@ -64,8 +64,10 @@ def test_depth_rules_in_raster_mode(files):
     assert (prov["painter"] != prov["zbuffer"]).any()
 
 
-def test_depth_with_a_file_name_still_writes_the_depth_image(files):
+def test_depth_takes_only_a_visibility_rule(files):
     r = _run(files / "sphere.asm", "-o", files / "s.png", "--depth", files / "d.npy", "--size", "32x24")
+    assert r.exit_code == 2 and "zbuffer" in r.output
+    r = _run(files / "sphere.asm", "-o", files / "s.png", "--depth-image", files / "d.npy", "--size", "32x24")
     assert r.exit_code == 0, r.output
     assert np.isfinite(np.load(files / "d.npy")).any()
 

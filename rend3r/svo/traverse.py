@@ -102,7 +102,8 @@ def setup_rays(origin: np.ndarray, direction: np.ndarray):
     """
     o = np.asarray(origin, dtype=np.float64).reshape(-1, 3)
     d = np.asarray(direction, dtype=np.float64).reshape(-1, 3)
-    scale = np.linalg.norm(d, axis=1)
+    # |d| summed in a fixed order (the compiled kernel repeats it operation for operation)
+    scale = np.sqrt((d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]) + d[:, 2] * d[:, 2])
     bad = ~np.isfinite(scale) | (scale == 0) | ~np.all(np.isfinite(o), axis=1)
     if bad.any():
         raise ValueError(f"{int(bad.sum())} rays have a non-finite origin or a zero/non-finite direction")
@@ -158,6 +159,11 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
     if stack_depth < 0:
         raise ValueError("stack depth must be >= 0")
     use, _ = resolve_kernel(kernel, fixed)
+    # a step cap far above any correct traversal; reaching it means a bug, not a hard ray
+    limit = 64 * 8 * (tree.depth + 1) * (1 << min(tree.depth, 12))
+    root_table = int(child_table(tree.words, np.zeros(1, dtype=np.int64))[0][0])
+    if use == "numba":
+        return _trace_numba(tree, origin, direction, root_table, stack_depth, limit, record)
     hits_root, dmask, rt0, rt1, shift, scale = setup_rays(origin, direction)
     n = len(hits_root)
     out = {name: np.zeros(n, dtype=np.int32) for name in
@@ -176,13 +182,7 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
         rt0q, rt1q = to_fixed(rt0[:, rid]), to_fixed(rt1[:, rid])
     else:
         rt0q, rt1q = rt0[:, rid].copy(), rt1[:, rid].copy()
-    root_table = int(child_table(tree.words, np.zeros(1, dtype=np.int64))[0][0])
     S = stack_depth
-    # a step cap far above any correct traversal; reaching it means a bug, not a hard ray
-    limit = 64 * 8 * (tree.depth + 1) * (1 << min(tree.depth, 12))
-    if use == "numba":
-        return _trace_numba(tree, rid, dmask[rid], rt0q.T, rt1q.T, shift, scale, n, root_table,
-                            S, limit, record)
     words = tree.words.astype(np.int64)
     root_word = int(words[0])
     zero_t = 0 if fixed else 0.0
@@ -388,15 +388,20 @@ def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: 
     return result
 
 
-def _trace_numba(tree: Octree, rid: np.ndarray, dmask: np.ndarray, rt0: np.ndarray, rt1: np.ndarray,
-                 shift: np.ndarray, scale: np.ndarray, n: int, root_table: int, stack_depth: int,
-                 limit: int, record: bool) -> TraceResult:
-    """:func:`trace` on the compiled kernel (fixed point; arguments as prepared there)."""
+def _trace_numba(tree: Octree, origin: np.ndarray, direction: np.ndarray, root_table: int,
+                 stack_depth: int, limit: int, record: bool) -> TraceResult:
+    """:func:`trace` on the compiled kernel (fixed point), ray setup included."""
     from .traverse_jit import trace_fixed
 
-    (hit, t, axis, code, requests, steps, descents, pops, restarts, max_level, max_stack,
-     rec_ray, rec_addr, rec_lvl) = trace_fixed(tree.words, rid, dmask, rt0, rt1, shift, scale, n,
-                                               root_table, stack_depth, limit, record)
+    o = np.asarray(origin, dtype=np.float64).reshape(-1, 3)
+    d = np.asarray(direction, dtype=np.float64).reshape(-1, 3)
+    if len(o) != len(d):
+        o, d = np.broadcast_arrays(o, d)
+    (bad, hit, t, axis, code, requests, steps, descents, pops, restarts, max_level, max_stack,
+     rec_ray, rec_addr, rec_lvl) = trace_fixed(tree.words, o, d, root_table, stack_depth, limit, record)
+    if bad:
+        raise ValueError(f"{bad} rays have a non-finite origin or a zero/non-finite direction")
+    n = len(hit)
     voxel = np.full((n, 3), -1, dtype=np.int64)
     voxel[hit] = morton_decode(code[hit], tree.depth)
     result = TraceResult(hit, t, axis, voxel, requests, steps, descents, pops, restarts,

@@ -20,11 +20,11 @@ import os
 import numpy as np
 from numba import njit
 
-from .fixed import ONE
+from .fixed import INT32_MAX, INT32_MIN, MIN_DIR, ONE
 
 _CACHE = os.environ.get("REND3R_JIT_CACHE", "1") != "0"
 #: initial trace capacity per ray (grown by doubling when a frame needs more)
-_TRACE_PER_RAY = 24
+_TRACE_PER_RAY = 16
 
 
 @njit(cache=_CACHE, nogil=True)
@@ -51,20 +51,41 @@ def _popcount8(x):
 
 @njit(cache=_CACHE, nogil=True)
 def _grow(buf, need):
-    if need <= buf.shape[0]:
-        return buf
+    """A copy of ``buf`` with room for at least ``need`` entries (doubling)."""
     out = np.empty(max(need, 2 * buf.shape[0]), dtype=buf.dtype)
     out[:buf.shape[0]] = buf
     return out
 
 
 @njit(cache=_CACHE, nogil=True)
-def _kernel(words, rid, dmask, rt0, rt1, shift, scale, n, root_table, stack_depth, limit, record):
-    """Trace rays ``rid`` (those that hit the root) through ``words``; see :func:`trace_fixed`."""
-    m = rid.shape[0]
+def _to_fixed(x):
+    """16.16 rounding of :func:`rend3r.svo.fixed.to_fixed` (round half to even)."""
+    v = np.rint(x * ONE)
+    if not (INT32_MIN <= v <= INT32_MAX):
+        raise OverflowError("value outside the 16.16 range [-32768, 32768)")
+    return np.int64(v)
+
+
+@njit(cache=_CACHE, nogil=True)
+def _clamp(x):
+    """Direction component clamped to |x| >= 2^-10 (0 counts as positive)."""
+    if abs(x) < MIN_DIR:
+        return -MIN_DIR if x < 0 else MIN_DIR
+    return x
+
+
+@njit(cache=_CACHE, nogil=True)
+def _kernel(words, origin, direction, root_table, stack_depth, limit, record):
+    """Set up and trace every ray; see :func:`trace_fixed`.
+
+    The ray setup repeats :func:`rend3r.svo.traverse.setup_rays` operation for operation
+    (the same float64 operations in the same order, hence the same roundings).
+    """
+    n = origin.shape[0]
     S = stack_depth
     one = float(ONE)
     root_word = np.int64(words[0])
+    bad = 0
     out_hit = np.zeros(n, dtype=np.bool_)
     out_t = np.full(n, np.inf)
     out_axis = np.full(n, -1, dtype=np.int8)
@@ -76,7 +97,7 @@ def _kernel(words, rid, dmask, rt0, rt1, shift, scale, n, root_table, stack_dept
     out_rest = np.zeros(n, dtype=np.int32)
     out_lvl = np.zeros(n, dtype=np.int8)
     out_stack = np.zeros(n, dtype=np.int8)
-    cap = m * _TRACE_PER_RAY + 16 if record else 1
+    cap = n * _TRACE_PER_RAY + 16 if record else 1
     rec_ray = np.empty(cap, dtype=np.int64)
     rec_addr = np.empty(cap, dtype=np.int64)
     rec_lvl = np.empty(cap, dtype=np.int64)
@@ -85,11 +106,27 @@ def _kernel(words, rid, dmask, rt0, rt1, shift, scale, n, root_table, stack_dept
     s_table = np.zeros(max(S, 1), dtype=np.int64)
     s_meta = np.zeros(max(S, 1), dtype=np.int64)
 
-    for k in range(m):
-        r = rid[k]
-        dm = dmask[k]
-        r00, r01, r02 = rt0[k, 0], rt0[k, 1], rt0[k, 2]
-        r10, r11, r12 = rt1[k, 0], rt1[k, 1], rt1[k, 2]
+    for r in range(n):
+        ox, oy, oz = origin[r, 0], origin[r, 1], origin[r, 2]
+        dx, dy, dz = direction[r, 0], direction[r, 1], direction[r, 2]
+        sc = np.sqrt((dx * dx + dy * dy) + dz * dz)
+        if not (np.isfinite(sc) and sc != 0 and np.isfinite(ox) and np.isfinite(oy)
+                and np.isfinite(oz)):
+            bad += 1
+            continue
+        nx, ny, nz = _clamp(dx / sc), _clamp(dy / sc), _clamp(dz / sc)
+        dm = (4 if nx < 0 else 0) | (2 if ny < 0 else 0) | (1 if nz < 0 else 0)
+        ax, ay, az = abs(nx), abs(ny), abs(nz)
+        mx, my, mz = -ox if nx < 0 else ox, -oy if ny < 0 else oy, -oz if nz < 0 else oz
+        f00, f01, f02 = (-1.0 - mx) / ax, (-1.0 - my) / ay, (-1.0 - mz) / az
+        f10, f11, f12 = (1.0 - mx) / ax, (1.0 - my) / ay, (1.0 - mz) / az
+        enter0 = max(max(f00, f01), f02)
+        leave0 = min(min(f10, f11), f12)
+        if not (enter0 < leave0 and leave0 > 0):
+            continue
+        sh = max(enter0, 0.0)
+        r00, r01, r02 = _to_fixed(f00 - sh), _to_fixed(f01 - sh), _to_fixed(f02 - sh)
+        r10, r11, r12 = _to_fixed(f10 - sh), _to_fixed(f11 - sh), _to_fixed(f12 - sh)
         t00, t01, t02, t10, t11, t12 = r00, r01, r02, r10, r11, r12
         tstart = np.int64(0)
         word = root_word
@@ -107,9 +144,10 @@ def _kernel(words, rid, dmask, rt0, rt1, shift, scale, n, root_table, stack_dept
         maxstack = 0
         idx = _first_index(t00, t01, t02, t10, t11, t12)
         if record:
-            rec_ray = _grow(rec_ray, nrec + 1)
-            rec_addr = _grow(rec_addr, nrec + 1)
-            rec_lvl = _grow(rec_lvl, nrec + 1)
+            if nrec + 1 > rec_ray.shape[0]:
+                rec_ray = _grow(rec_ray, nrec + 1)
+                rec_addr = _grow(rec_addr, nrec + 1)
+                rec_lvl = _grow(rec_lvl, nrec + 1)
             rec_ray[nrec] = r
             rec_addr[nrec] = 0
             rec_lvl[nrec] = 0
@@ -139,7 +177,7 @@ def _kernel(words, rid, dmask, rt0, rt1, shift, scale, n, root_table, stack_dept
                 enter = max(max(c00, c01), c02)
                 axis = 0 if c00 == enter else (1 if c01 == enter else 2)
                 out_hit[r] = True
-                out_t[r] = (max(enter / one, 0.0) + shift[r]) / scale[r]
+                out_t[r] = (max(enter / one, 0.0) + sh) / sc
                 out_axis[r] = axis
                 out_code[r] = (code << 3) | cidx
                 break
@@ -154,9 +192,10 @@ def _kernel(words, rid, dmask, rt0, rt1, shift, scale, n, root_table, stack_dept
                 requests += 1 + isfar
                 descents += 1
                 if record:
-                    rec_ray = _grow(rec_ray, nrec + 2)
-                    rec_addr = _grow(rec_addr, nrec + 2)
-                    rec_lvl = _grow(rec_lvl, nrec + 2)
+                    if nrec + 2 > rec_ray.shape[0]:
+                        rec_ray = _grow(rec_ray, nrec + 2)
+                        rec_addr = _grow(rec_addr, nrec + 2)
+                        rec_lvl = _grow(rec_lvl, nrec + 2)
                     rec_ray[nrec] = r
                     rec_addr[nrec] = caddr
                     rec_lvl[nrec] = lvl
@@ -167,7 +206,7 @@ def _kernel(words, rid, dmask, rt0, rt1, shift, scale, n, root_table, stack_dept
                         rec_lvl[nrec] = lvl
                         nrec += 1
                 if S:
-                    top = (top + 1) % S
+                    top = top + 1 if top + 1 < S else 0
                     s_word[top] = word
                     s_table[top] = table
                     s_meta[top] = idx | (((s0 & 1) << 2 | (s1 & 1) << 1 | (s2 & 1)) << 3)
@@ -210,7 +249,7 @@ def _kernel(words, rid, dmask, rt0, rt1, shift, scale, n, root_table, stack_dept
                 idx = pidx
                 level -= 1
                 code >>= 3
-                top = (top + S - 1) % S
+                top = top - 1 if top > 0 else S - 1
                 count -= 1
                 pops += 1
             else:
@@ -223,9 +262,10 @@ def _kernel(words, rid, dmask, rt0, rt1, shift, scale, n, root_table, stack_dept
                 restarts += 1
                 requests += 1
                 if record:
-                    rec_ray = _grow(rec_ray, nrec + 1)
-                    rec_addr = _grow(rec_addr, nrec + 1)
-                    rec_lvl = _grow(rec_lvl, nrec + 1)
+                    if nrec + 1 > rec_ray.shape[0]:
+                        rec_ray = _grow(rec_ray, nrec + 1)
+                        rec_addr = _grow(rec_addr, nrec + 1)
+                        rec_lvl = _grow(rec_lvl, nrec + 1)
                     rec_ray[nrec] = r
                     rec_addr[nrec] = 0
                     rec_lvl[nrec] = 0
@@ -237,27 +277,21 @@ def _kernel(words, rid, dmask, rt0, rt1, shift, scale, n, root_table, stack_dept
         out_rest[r] = restarts
         out_lvl[r] = maxlvl
         out_stack[r] = maxstack
-    return (out_hit, out_t, out_axis, out_code, out_req, out_steps, out_desc, out_pops,
+    return (bad, out_hit, out_t, out_axis, out_code, out_req, out_steps, out_desc, out_pops,
             out_rest, out_lvl, out_stack, rec_ray[:nrec], rec_addr[:nrec], rec_lvl[:nrec])
 
 
-def trace_fixed(words: np.ndarray, rid: np.ndarray, dmask: np.ndarray, rt0: np.ndarray,
-                rt1: np.ndarray, shift: np.ndarray, scale: np.ndarray, n: int, root_table: int,
-                stack_depth: int, limit: int, record: bool) -> tuple[np.ndarray, ...]:
-    """Run the kernel on ``n`` rays of which ``rid`` hit the root.
+def trace_fixed(words: np.ndarray, origin: np.ndarray, direction: np.ndarray, root_table: int,
+                stack_depth: int, limit: int, record: bool) -> tuple:
+    """Set up and trace rays ``origin + t * direction`` (arrays (n, 3), octree space).
 
-    ``rt0``/``rt1`` are the root t-values of rays ``rid`` as 16.16 integers, shape (m, 3);
-    ``dmask``/``rid`` have length m, ``shift``/``scale`` length n (see
-    :func:`rend3r.svo.traverse.setup_rays`). Returns per-ray arrays (hit, t, axis, Morton
-    code, requests, steps, descents, pops, restarts, max level, max stack) and the
+    Returns the number of refused rays (non-finite origin, zero or non-finite direction;
+    the caller raises if it is not 0), then per-ray arrays (hit, t, axis, Morton code,
+    requests, steps, descents, pops, restarts, max level, max stack) and the
     memory-request trace (ray, address, level) in ray-major, chronological order (empty
     unless ``record``).
     """
     return _kernel(np.ascontiguousarray(words, dtype=np.uint32),
-                   np.ascontiguousarray(rid, dtype=np.int64),
-                   np.ascontiguousarray(dmask, dtype=np.int64),
-                   np.ascontiguousarray(rt0, dtype=np.int64),
-                   np.ascontiguousarray(rt1, dtype=np.int64),
-                   np.ascontiguousarray(shift, dtype=np.float64),
-                   np.ascontiguousarray(scale, dtype=np.float64),
-                   int(n), int(root_table), int(stack_depth), int(limit), bool(record))
+                   np.ascontiguousarray(origin, dtype=np.float64),
+                   np.ascontiguousarray(direction, dtype=np.float64),
+                   int(root_table), int(stack_depth), int(limit), bool(record))

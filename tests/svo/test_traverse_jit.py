@@ -210,3 +210,22 @@ def test_help_does_not_import_numba():
             "print('numba' in sys.modules)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+@needs_numba
+def test_shared_origin_and_refused_rays_like_numpy(models):
+    """One origin broadcast over many directions; unusable rays are refused by both kernels."""
+    tree = models["random5"]
+    _, d = _rays(300, 9)
+    o = np.array([[0.1, 2.5, -2.0]])
+    for kernel in ("numpy", "numba"):
+        assert trace(tree, o, d, 8, kernel=kernel).hit.any()
+    a = trace(tree, o, d, 8, kernel="numpy")
+    b = trace(tree, o, d, 8, kernel="numba")
+    assert np.array_equal(a.t, b.t) and np.array_equal(a.voxel, b.voxel)
+    for o_bad, d_bad, err in (([[0.0, 0, 0]], [[0.0, 0, 0]], ValueError),
+                              ([[0.0, np.inf, 0]], [[1.0, 0, 0]], ValueError),
+                              ([[0.0, 0, 0]], [[np.nan, 1, 0]], ValueError)):
+        for kernel in ("numpy", "numba"):
+            with pytest.raises(err):
+                trace(tree, np.array(o_bad), np.array(d_bad), kernel=kernel)

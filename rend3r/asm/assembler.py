@@ -4,6 +4,8 @@ Lines are read one at a time: the fast path (:mod:`.fastpath`) encodes plain
 instruction lines, everything else goes through the Lark grammar (:mod:`.parser`) and is
 checked here against :mod:`rend3r.isa.tables`. Statements run as soon as they are read,
 except inside a ``.rept`` block, whose body is collected and then run once per iteration.
+ISA extensions (``ts`` of the hybrid extension, :mod:`rend3r.isa.extensions`) are accepted
+only once enabled, by ``isa_ext=`` or a ``.isa_ext`` directive.
 """
 
 from __future__ import annotations
@@ -14,10 +16,11 @@ import re
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Iterable
+from typing import Iterable, Mapping
 
 from ..errors import Rend3rError
 from ..isa.encoding import CameraSet, FrameOp, LightSet, ShapeSet, encode
+from ..isa.extensions import table_select_word
 from ..isa.float16 import Rounded, round_literal, shortest_repr
 from ..isa.tables import (
     F_MNEMONICS,
@@ -53,9 +56,17 @@ MAX_STATEMENTS = 1 << 20
 WORD_LIMIT = 1 << 32
 
 MNEMONICS = (*F_MNEMONICS, *MNEMONIC_TABLE)
-DIRECTIVES = (".include", ".rept", ".endr", ".word")
+DIRECTIVES = (".include", ".rept", ".endr", ".word", ".isa_ext")
+#: ISA extensions a program may opt into (docs/isa-extensions.md) -> the mnemonics each adds
+ISA_EXTENSIONS: Mapping[str, tuple[str, ...]] = {"hybrid": ("ts",)}
+#: what ``isa_ext=`` accepts: one extension name, several, or None
+IsaExt = str | Iterable[str] | None
+_EXTENSION_OF = {m: name for name, ms in ISA_EXTENSIONS.items() for m in ms}
+#: ``ts`` operand -> the table it selects
+TS_TABLES = {"shape": Table.SHAPE, "triangle": Table.TRIANGLE}
 _OPERANDS = {"cam": "PROP, VALUE", "lt": "INDEX, PROP, VALUE", "sp": "INDEX, PROP, PROP2, VALUE, VALUE2"}
 _OPERANDS["tr"] = _OPERANDS["sp"]
+_PAIRS = ("sp", "tr")  # the SE/SD mnemonics, whose table TS selects under the hybrid extension
 _REGISTER = re.compile(r"a(\d+)", re.IGNORECASE)
 
 
@@ -83,6 +94,15 @@ class AssemblyResult:
     def format_diagnostics(self) -> str:
         """Every diagnostic with its source line and caret, then a summary line."""
         return format_all(self.diagnostics)
+
+
+def resolve_isa_ext(isa_ext: IsaExt) -> frozenset[str]:
+    """The set of ISA extension names ``isa_ext`` enables (one name, or several)."""
+    names = {isa_ext} if isinstance(isa_ext, str) else set(isa_ext or ())
+    unknown = sorted(n for n in names if n.lower() not in ISA_EXTENSIONS)
+    if unknown:
+        raise Rend3rError(f"unknown ISA extension '{unknown[0]}' (known: {', '.join(sorted(ISA_EXTENSIONS))})")
+    return frozenset(n.lower() for n in names)
 
 
 class _Abort(Exception):
@@ -139,7 +159,7 @@ class Assembler:
     """One assembler run; use :func:`assemble_source` or :func:`assemble_file`."""
 
     def __init__(self, include_paths: Iterable[str | os.PathLike[str]] = (), target: str | Target | None = None,
-                 fast: bool = True) -> None:
+                 fast: bool = True, isa_ext: IsaExt = ()) -> None:
         self.include_paths = [Path(p) for p in include_paths]
         self.target = resolve_target(target)
         self.limits = (
@@ -159,6 +179,20 @@ class Assembler:
         self.rounded: dict[tuple[int | Fraction, bool], Rounded] = {}  # round_literal cache
         # where the statement being run comes from: file, line, text, context
         self.where: tuple[str, int, str, tuple[str, ...]] = ("", 0, "", ())
+        self.mnemonic_names: tuple[str, ...] = MNEMONICS  # the base ones and those of enabled extensions
+        self.hybrid = False  # the hybrid extension is enabled (ts; sp/tr checked against the selection)
+        self.selected = Table.SHAPE  # the table the last ts selected (a program starts with the shape table)
+        self.ts_seen = False
+        self.selection_warned = False  # a mismatch was reported since the last ts
+        for name in resolve_isa_ext(isa_ext):
+            self.enable(name)
+
+    def enable(self, extension: str) -> None:
+        """Accept the mnemonics of ISA extension ``extension`` (a key of ISA_EXTENSIONS)."""
+        new = tuple(m for m in ISA_EXTENSIONS[extension] if m not in self.mnemonic_names)
+        self.mnemonic_names += new
+        if extension == "hybrid":
+            self.hybrid = True
 
     # -- diagnostics -------------------------------------------------------------------
 
@@ -202,6 +236,8 @@ class Assembler:
                     entries.append(Emitted(self.address, words, loc, line))
                     self.address += len(words)
                     self.mnemonics.add(mnemonic)
+                    if self.hybrid and mnemonic in _PAIRS:
+                        self.check_selection(mnemonic, loc, line, context)
                 else:
                     body.append(_Fixed(mnemonic, words, loc, line))
                 continue
@@ -259,6 +295,8 @@ class Assembler:
         if isinstance(item, _Fixed):
             self.count_statement()
             self.emit(item.mnemonic, item.words, item.loc, item.text)
+            if self.hybrid and item.mnemonic in _PAIRS:
+                self.check_selection(item.mnemonic, item.loc, item.text, context)
         elif isinstance(item, _Rept):
             self.run_rept(item, context)
         else:
@@ -318,7 +356,7 @@ class Assembler:
             self.error(f"{what} must be a name", node.col, node.end)
             return None
         name = node.name
-        if name.lower() in MNEMONICS:
+        if name.lower() in self.mnemonic_names:
             self.error(f"'{name}' is a mnemonic and cannot name {what}", node.col, node.end)
             return None
         if name in self.env:
@@ -381,9 +419,16 @@ class Assembler:
             return
         table = MNEMONIC_TABLE.get(m)
         if table is None:
-            close = difflib.get_close_matches(m, MNEMONICS, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            self.error(f"unknown mnemonic '{stmt.mnemonic}'{hint}", stmt.col, stmt.end)
+            if m in self.mnemonic_names:
+                self.table_select(stmt, loc, text)
+            elif m in _EXTENSION_OF:
+                ext = _EXTENSION_OF[m]
+                self.error(f"unknown mnemonic '{stmt.mnemonic}': it belongs to the {ext} ISA extension; "
+                           f"enable it with '.isa_ext {ext}' in the source (or --isa-ext {ext})", stmt.col, stmt.end)
+            else:
+                close = difflib.get_close_matches(m, self.mnemonic_names, n=1)
+                hint = f"; did you mean '{close[0]}'?" if close else ""
+                self.error(f"unknown mnemonic '{stmt.mnemonic}'{hint}", stmt.col, stmt.end)
             return
         expected = _OPERANDS[m].count(",") + 1
         if len(ops) != expected:
@@ -417,6 +462,43 @@ class Assembler:
             )
         if index is not None and data is not None and data2 is not None:
             self.emit(m, encode(ShapeSet(index, prop.index, prop2.index, data, data2)), loc, text)
+            if self.hybrid:
+                self.check_selection(m, loc, text, self.where[3])
+
+    def table_select(self, stmt: Instruction, loc: SourceLoc, text: str) -> None:
+        """``ts shape`` / ``ts triangle`` (hybrid extension): one TS word."""
+        ops = stmt.operands
+        if len(ops) != 1:
+            end = ops[-1].end if ops else stmt.end
+            self.error(f"'ts' takes one operand (shape or triangle), got {len(ops)}", stmt.col, end)
+            return
+        node = ops[0]
+        name = node.name.lower() if isinstance(node, Ref) else ""
+        if name not in TS_TABLES:
+            close = difflib.get_close_matches(name, TS_TABLES, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            self.error(f"'ts' selects 'shape' or 'triangle', not '{self.source(node)}'{hint}", node.col, node.end)
+            return
+        self.selected = TS_TABLES[name]
+        self.ts_seen = True
+        self.selection_warned = False
+        self.emit("ts", (table_select_word(self.selected),), loc, text)
+
+    def check_selection(self, mnemonic: str, loc: SourceLoc, text: str, context: tuple[str, ...]) -> None:
+        """Under the hybrid extension, warn (once per ts) when an sp/tr pair writes the
+        table the last ``ts`` selected rather than the one its mnemonic names."""
+        table = MNEMONIC_TABLE[mnemonic]
+        if table is self.selected or self.selection_warned:
+            return
+        self.selection_warned = True
+        self.where = (loc.file, loc.line, text, context)
+        why = "the last 'ts' selected it" if self.ts_seen else "a hybrid program starts with it selected"
+        self.warning(
+            f"'{mnemonic}' writes the {self.selected.value} table here ({why}); "
+            f"put 'ts {table.value}' before it",
+            loc.col,
+            loc.col + len(mnemonic),
+        )
 
     def target_index(self, m: str, table: Table, index: int, node: Operand) -> None:
         if self.limits and index >= self.limits[m]:
@@ -506,6 +588,8 @@ class Assembler:
             words = [self.integer(a, ".word value", 0, WORD_LIMIT) for a in stmt.args]
             if None not in words:
                 self.emit("", tuple(words), SourceLoc(item.file, item.line, stmt.col), item.text)
+        elif kind == ".isa_ext":
+            self.isa_ext_directive(stmt)
         elif kind == ".include":
             if len(stmt.args) != 1 or not isinstance(stmt.args[0], Str):
                 self.error('.include takes one quoted path: .include "file.asm"', stmt.col, stmt.end)
@@ -515,6 +599,22 @@ class Assembler:
             close = difflib.get_close_matches(kind, DIRECTIVES, n=1)
             hint = f"; did you mean '{close[0]}'?" if close else ""
             self.error(f"unknown directive '{stmt.name}'{hint}", stmt.col, stmt.end)
+
+    def isa_ext_directive(self, stmt: Directive) -> None:
+        """``.isa_ext NAME[, NAME...]``: enable ISA extensions from this line on."""
+        if not stmt.args:
+            self.error(f".isa_ext takes an extension name: .isa_ext {next(iter(ISA_EXTENSIONS))}", stmt.col, stmt.end)
+        for arg in stmt.args:
+            if not isinstance(arg, Ref):
+                self.error(f".isa_ext takes extension names, not '{self.source(arg)}'", arg.col, arg.end)
+                continue
+            name = arg.name.lower()
+            if name in ISA_EXTENSIONS:
+                self.enable(name)
+                continue
+            close = difflib.get_close_matches(name, ISA_EXTENSIONS, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else f" (known: {', '.join(ISA_EXTENSIONS)})"
+            self.error(f"unknown ISA extension '{arg.name}'{hint}", arg.col, arg.end)
 
     def include(self, arg: Str, item: _Stmt, context: tuple[str, ...]) -> None:
         base = Path(item.file).parent
@@ -585,12 +685,15 @@ def assemble_source(
     *,
     werror: bool = False,
     fast: bool = True,
+    isa_ext: IsaExt = (),
 ) -> AssemblyResult:
     """Assemble source text. ``.include`` paths are relative to ``filename``'s directory
     (the current directory for ``<input>``), then to each of ``include_paths``.
-    ``fast=False`` parses every line with the full grammar (for testing the fast path).
+    ``isa_ext`` names ISA extensions to enable from the start (``"hybrid"``, or several;
+    a source can also enable them with ``.isa_ext``). ``fast=False`` parses every line
+    with the full grammar (for testing the fast path).
     """
-    asm = Assembler(include_paths, target, fast)
+    asm = Assembler(include_paths, target, fast, isa_ext)
     if filename != "<input>":
         asm.include_stack.append(Path(filename).resolve())
     try:
@@ -608,23 +711,26 @@ def assemble_file(
     target: str | Target | None = None,
     *,
     werror: bool = False,
+    isa_ext: IsaExt = (),
 ) -> AssemblyResult:
     """Assemble a source file; a missing or unreadable file is an error diagnostic."""
-    asm = Assembler(include_paths, target)
+    asm = Assembler(include_paths, target, isa_ext=isa_ext)
     name = str(path)
     text = read_source(Path(path), lambda message: asm.diagnostics.append(Diagnostic(ERROR, message, name, 0)))
     if text is None:
         return _result(asm, werror)
-    return assemble_source(text, name, include_paths, target, werror=werror)
+    return assemble_source(text, name, include_paths, target, werror=werror, isa_ext=isa_ext)
 
 
 def assemble_or_raise(
     path: str | os.PathLike[str],
     include_paths: Iterable[str | os.PathLike[str]] = (),
     target: str | Target | None = None,
+    *,
+    isa_ext: IsaExt = (),
 ) -> AssemblyResult:
     """Assemble a file, raising :class:`Rend3rError` with every diagnostic on errors."""
-    result = assemble_file(path, include_paths, target)
+    result = assemble_file(path, include_paths, target, isa_ext=isa_ext)
     if not result.ok:
         raise Rend3rError(result.format_diagnostics())
     return result

@@ -44,6 +44,7 @@ Examples:
                                           write build/scene.mem and build/scene.lst
   rend3r asm scene.asm -f bin -o scene.bin --byteorder little
   rend3r asm scene.asm --target rend3r-main -W error -I lib/
+  rend3r asm mix.asm --isa-ext hybrid     accept ts (table select) for hybrid frames
 """,
 )
 @click.argument("src", type=click.Path(dir_okay=False, path_type=Path))
@@ -57,10 +58,13 @@ Examples:
               help="Warn about indices and program sizes beyond this device build's memories.")
 @click.option("--byteorder", type=click.Choice(["big", "little"]), default="big", show_default=True,
               help="Byte order of each word in bin and ihex output.")
+@click.option("--isa-ext", "isa_ext", multiple=True, metavar="NAME",
+              help="Enable an ISA extension (hybrid: the ts table-select word); repeatable. "
+                   "A source can say .isa_ext NAME instead.")
 @click.option("-W", "warn", type=click.Choice(["error"]), help="-W error: treat warnings as errors.")
 @click.option("--werror", is_flag=True, help="Treat warnings as errors (same as -W error).")
 def asm_command(src: Path, out: str | None, formats: tuple[str, ...], include_dirs: tuple[str, ...],
-                target: str | None, byteorder: str, warn: str | None, werror: bool) -> None:
+                target: str | None, isa_ext: tuple[str, ...], byteorder: str, warn: str | None, werror: bool) -> None:
     """Assemble SRC (a .asm file) into memory images for the REND3R device.
 
     Diagnostics go to standard error. On any error the exit status is 1 and no output
@@ -75,7 +79,7 @@ def asm_command(src: Path, out: str | None, formats: tuple[str, ...], include_di
     for fmt, path in paths.items():
         if path is None and FORMATS[fmt].binary and sys.stdout.isatty():
             raise Rend3rError(f"{fmt} output is binary: give -o FILE (or redirect standard output)")
-    result = assemble_file(src, include_dirs, target, werror=werror or warn == "error")
+    result = assemble_file(src, include_dirs, target, werror=werror or warn == "error", isa_ext=isa_ext)
     if result.diagnostics:
         click.echo(result.format_diagnostics(), err=True)
     if not result.ok:

@@ -8,6 +8,7 @@ Markers in a line's trailing comment:
 and on lines of their own:
   ``;! target NAME``         assemble with ``--target NAME``
   ``;! werror``              assemble with ``-W error``
+  ``;! isa-ext NAME``        assemble with ``--isa-ext NAME``
   ``;! file-warning: TEXT``  a warning about the whole program (no line)
 A line without ``=>`` must emit nothing, and every diagnostic must be expected.
 """
@@ -27,7 +28,7 @@ SOURCES = sorted(ROOT.glob("*.asm"))
 
 _WORDS = re.compile(r";\s*=>\s*((?:0x[0-9a-f]{8}\s*)+)")
 _DIAG = re.compile(r";\s*(error|warning):\s*([^;]+?)\s*(?=;|$)")
-_PRAGMA = re.compile(r"^;!\s*(target\s+(\S+)|werror|file-warning:\s*(.+?))\s*$")
+_PRAGMA = re.compile(r"^;!\s*(target\s+(\S+)|werror|file-warning:\s*(.+?)|isa-ext\s+(\S+))\s*$")
 
 
 def _markers(path: Path) -> tuple[dict[int, list[int]], dict[int, list[tuple[str, str]]]]:
@@ -47,16 +48,18 @@ def test_suite_is_present():
 
 @pytest.mark.parametrize("path", SOURCES, ids=[p.name for p in SOURCES])
 def test_conformance(path: Path):
-    target, werror, file_warnings = None, False, []
+    target, werror, file_warnings, isa_ext = None, False, [], []
     for line in path.read_text(encoding="utf-8").split("\n"):
         if m := _PRAGMA.match(line.strip()):
             if m.group(2):
                 target = m.group(2)
+            elif m.group(4):
+                isa_ext.append(m.group(4))
             elif m.group(1) == "werror":
                 werror = True
             else:
                 file_warnings.append(m.group(3))
-    result = assemble_file(path, include_paths=[ROOT / "include"], target=target, werror=werror)
+    result = assemble_file(path, include_paths=[ROOT / "include"], target=target, werror=werror, isa_ext=isa_ext)
 
     emitted: dict[tuple[str, int], list[int]] = defaultdict(list)
     for entry in result.program.entries:

@@ -33,7 +33,8 @@ er
 er
 """
 
-_PIECES = list("0123456789abcxhe_.,-+*/()=;\"@ \t\n") + ["0h", "0x", "0b", ".rept", ".endr", ".include", "er", "sp", "xloc", "//"]
+_PIECES = list("0123456789abcxhe_.,-+*/()=;\"@ \t\n") + ["0h", "0x", "0b", ".rept", ".endr", ".include", "er", "sp", "xloc", "//",
+                                                  ".isa_ext hybrid\n", "ts shape\n", "ts triangle", "ts "]
 
 
 @st.composite

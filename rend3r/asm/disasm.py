@@ -2,16 +2,20 @@
 
 Every word stream disassembles to source that assembles back to the same words: words
 that decode to nothing become ``.word`` directives with a comment giving the reason.
+With the hybrid ISA extension (``isa_ext="hybrid"``), TS words print as ``ts shape`` /
+``ts triangle`` and name the following SE/SD pairs ``sp`` / ``tr``.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
 from ..isa.encoding import is_canonical
+from ..isa.extensions import TS_OPCODE, TS_TABLE, decode_table_select
 from ..isa.float16 import bits_to_float, is_subnormal, round_literal, shortest_repr
 from ..isa.tables import (
     DATA,
@@ -37,6 +41,9 @@ from .program import Emitted, Program
 
 #: mode -> (shape mnemonic, the table its property operands name)
 MODES: dict[str, tuple[str, Table]] = {"raytrace": ("sp", Table.SHAPE), "raster": ("tr", Table.TRIANGLE)}
+#: ISA extensions the disassembler prints (named as the assembler's ``.isa_ext`` names them)
+ISA_EXTENSIONS = ("hybrid",)
+_PAIR_MNEMONIC = {table: mnemonic for mnemonic, table in MODES.values()}
 
 _F_NAMES = {func: name for name, func in F_MNEMONICS.items()}
 _COMMENT_COLUMN = 40
@@ -125,9 +132,19 @@ def _single(address: int, word: int) -> Line:
     return _word(address, word, f"unused opcode {op:03b}")
 
 
-def _pair(address: int, se: int, sd: int, mode: str) -> list[Line]:
+def _table_select(address: int, word: int) -> Line:
+    """An opcode-010 word under the hybrid extension: ``ts TABLE``, or a .word saying why not."""
+    table = decode_table_select(word)
+    if table is not None:
+        return Line(address, (word,), f"ts {table.value}")
+    if word >> (TS_TABLE.hi + 1):
+        return _word(address, word, "opcode 010 with nonzero bits 31:5 (not a TS word)")
+    return _word(address, word, f"opcode 010 with reserved table code {TS_TABLE.get(word):02b} (not a TS word)")
+
+
+def _pair(address: int, se: int, sd: int, table: Table) -> list[Line]:
     """An SE/SD pair as one sp/tr line, or as two .word lines when a property is missing."""
-    mnemonic, table = MODES[mode]
+    mnemonic = _PAIR_MNEMONIC[table]
     props = by_index(table)
     prop, prop2 = props.get(PROP.get(se)), props.get(SE_PROP2.get(se))
     if prop is None or prop2 is None:
@@ -141,42 +158,74 @@ def _pair(address: int, se: int, sd: int, mode: str) -> list[Line]:
     return [Line(address, (se, sd), f"{mnemonic} {index}, {prop.name}, {prop2.name}, {v1}, {v2}")]
 
 
-def disassemble_lines(words: list[int], mode: str = "raytrace") -> list[Line]:
-    """Decode ``words`` as the device does (an SE always takes the next word as its SD)."""
+def _is_hybrid(mode: str, isa_ext: str | Iterable[str] | None) -> bool:
+    """Whether the hybrid extension applies; ValueError for an unknown mode or extension,
+    or raster mode with it (a hybrid program starts with the shape table selected)."""
     if mode not in MODES:
         raise ValueError(f"unknown mode {mode!r}; expected one of {', '.join(MODES)}")
+    names = {isa_ext.lower()} if isinstance(isa_ext, str) else {n.lower() for n in isa_ext or ()}
+    unknown = names - set(ISA_EXTENSIONS)
+    if unknown:
+        raise ValueError(f"unknown ISA extension {sorted(unknown)[0]!r}; expected one of {', '.join(ISA_EXTENSIONS)}")
+    if "hybrid" in names and mode != "raytrace":
+        raise ValueError(f"{mode} mode does not apply with the hybrid extension: a program starts with the shape "
+                         "table selected and ts words choose the table")
+    return "hybrid" in names
+
+
+def disassemble_lines(words: list[int], mode: str = "raytrace", isa_ext: str | Iterable[str] | None = ()) -> list[Line]:
+    """Decode ``words`` as the device does (an SE always takes the next word as its SD).
+
+    Under the hybrid extension (``isa_ext="hybrid"``) a TS word selects the table (and so
+    the mnemonic and property names) of the SE/SD pairs after it.
+    """
+    hybrid = _is_hybrid(mode, isa_ext)
+    table = MODES[mode][1]
     lines: list[Line] = []
     address = 0
     while address < len(words):
         word = words[address]
         if not 0 <= word < 1 << 32:
             raise ValueError(f"word {word} at address {address} is not a 32-bit value")
-        if OPCODE.get(word) == Opcode.SE:
+        op = OPCODE.get(word)
+        if op == Opcode.SE:
             if address + 1 == len(words):
                 lines.append(_word(address, word, "SE with no SD at the end"))
                 break
-            lines.extend(_pair(address, word, words[address + 1], mode))
+            lines.extend(_pair(address, word, words[address + 1], table))
             address += 2
+            continue
+        if hybrid and op == TS_OPCODE:
+            lines.append(_table_select(address, word))
+            table = decode_table_select(word) or table
         else:
             lines.append(_single(address, word))
-            address += 1
+        address += 1
     return lines
 
 
-def disassemble_program(words: list[int], mode: str = "raytrace") -> Program:
+def disassemble_program(words: list[int], mode: str = "raytrace", isa_ext: str | Iterable[str] | None = ()) -> Program:
     """The disassembly as a Program (no source positions), e.g. for a listing."""
-    return Program([Emitted(line.address, line.words, None, _with_note(line.text, line.note)) for line in disassemble_lines(words, mode)])
+    lines = disassemble_lines(words, mode, isa_ext)
+    return Program([Emitted(line.address, line.words, None, _with_note(line.text, line.note)) for line in lines])
 
 
-def disassemble(words: list[int], mode: str = "raytrace", addresses: bool = False) -> str:
+def disassemble(words: list[int], mode: str = "raytrace", addresses: bool = False,
+                isa_ext: str | Iterable[str] | None = ()) -> str:
     """Canonical source for ``words``: a header comment, then one statement per line.
 
     ``addresses`` adds each statement's word address (hex) as a trailing comment.
+    ``isa_ext="hybrid"`` prints TS words as ``ts`` (see :func:`disassemble_lines`) after an
+    ``.isa_ext hybrid`` line, so the source assembles without a flag.
     """
-    lines = disassemble_lines(words, mode)
+    lines = disassemble_lines(words, mode, isa_ext)
     width = address_width(len(words))
-    mnemonic, table = MODES[mode]
-    out = [f"; rend3r disassembly: {count_words(len(words))}, {mode} mode ({mnemonic} names {table.value} properties)"]
+    if _is_hybrid(mode, isa_ext):
+        out = [f"; rend3r disassembly: {count_words(len(words))}, hybrid ISA extension "
+               "(ts selects the table: sp names shape properties, tr triangle ones)", ".isa_ext hybrid"]
+    else:
+        mnemonic, table = MODES[mode]
+        out = [f"; rend3r disassembly: {count_words(len(words))}, {mode} mode ({mnemonic} names {table.value} properties)"]
     for line in lines:
         if addresses:
             comment = f"@{line.address:0{width}x} {line.note}".rstrip()

@@ -1,12 +1,12 @@
 ; hybrid_mix.asm: analytic shapes and triangles in one frame (--mode hybrid).
 ;
-; Shows:  the TS table-select extension (docs/isa-extensions.md): `.word 0x0000000A`
-;         (ts shape) routes the following sp pairs to the shape table, `.word 0x00000012`
-;         (ts triangle) routes tr pairs to the triangle table. Each nf raytraces the
-;         shapes, rasterizes the triangles through the same camera and keeps the nearer
-;         surface per pixel. A triangle floor and an orange pyramid of four triangles; a
-;         red sphere that pierces the pyramid's left face and a blue one in front of it
-;         at the right. Triangles are flat-shaded and take no shadows.
+; Shows:  the TS table-select extension (docs/isa-extensions.md), enabled by the
+;         `.isa_ext hybrid` line below: `ts shape` routes the following sp pairs to the
+;         shape table, `ts triangle` routes tr pairs to the triangle table. Each nf
+;         raytraces the shapes, rasterizes the triangles through the same camera and
+;         keeps the nearer surface per pixel. A triangle floor and an orange pyramid of
+;         four triangles; a red sphere that pierces the pyramid's left face and a blue
+;         one in front of it at the right. Triangles are flat-shaded and take no shadows.
 ; Run:    rend3r emulate programs/hybrid_mix.asm --mode hybrid -o hybrid_mix.png
 ; Look:   a grey triangle floor ending in a straight far edge, the orange front face of
 ;         the pyramid, the red sphere half hidden behind it where it pierces the face, the
@@ -14,6 +14,7 @@
 ; frames: 1
 ; mode: hybrid
 
+.isa_ext hybrid                  ; accept ts (no assembler flag needed)
 nr
 cam rrot, 1
 cam hfov, 0.25
@@ -25,7 +26,7 @@ lt 0, zfor, -0.6
 lt 0, col, 0xFFFF
 lt 0, int, 1
 
-.word 0x0000000A                 ; ts shape: sp pairs write the shape table
+ts shape                         ; sp pairs write the shape table
 sp 0, type, col, 1, 0b11111_000100_00100   ; red sphere piercing the pyramid
 sp 0, xloc, yloc, -0.7, -0.1
 sp 0, zloc, rrot, -5.5, 1
@@ -37,7 +38,7 @@ sp 1, zloc, rrot, -3.6, 1
 sp 1, xscl, yscl, 1 / 0.45, 1 / 0.45
 sp 1, zscl, mat, 1 / 0.45, 0
 
-.word 0x00000012                 ; ts triangle: tr pairs write the triangle table
+ts triangle                      ; tr pairs write the triangle table
 ; 0-1: floor at y = -1; 2-5: pyramid faces (wound counter-clockwise from outside)
 tr 0, x1, y1, -4, -1
 tr 0, z1, x2, -2, 4

@@ -7,6 +7,7 @@ import sys
 
 import click
 
+from ..cliutil import SIZE
 from ..errors import Rend3rError
 
 _EPILOG = """\b
@@ -17,16 +18,6 @@ Examples:
   rend3r emulate programs/tri_cube.asm -o cube.png --depth painter
   rend3r emulate programs/sphere.asm -o board.png --profile rend3r-2022 --trace-pixel 252,188 --trace t.jsonl
 """
-
-
-def _size(ctx, param, value: str) -> tuple[int, int]:
-    try:
-        w, h = (int(v) for v in value.lower().split("x"))
-    except ValueError:
-        raise click.BadParameter(f"expected WIDTHxHEIGHT such as 512x384, not {value!r}") from None
-    if not (1 <= w <= 8192 and 1 <= h <= 8192):
-        raise click.BadParameter(f"width and height must be 1..8192, not {value!r}")
-    return w, h
 
 
 def _colour(ctx, param, value: str) -> int:
@@ -41,19 +32,20 @@ def _colour(ctx, param, value: str) -> int:
 
 @click.command("emulate", epilog=_EPILOG)
 @click.argument("program", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", help="PNG per frame: a name, or a pattern like out/frame_{n:03}.png for several.")
-@click.option("--frames", type=int, help="Render at most N frames (required for programs that loop with lr).")
+@click.option("-o", "--output", help="PNG per frame: a name, or a pattern like out/frame_{n:03}.png for several "
+              "(a pattern's folders are created; a plain name's folder must exist).")
+@click.option("--frames", type=click.IntRange(min=1), help="Render at most N frames (required for programs that loop with lr).")
 @click.option("--mode", type=click.Choice(["raytrace", "raster", "hybrid"]), help="How SE/SD data is read (default: from the source's sp/tr, else raytrace); hybrid: shapes and triangles in one frame (docs/isa-extensions.md).")
 @click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormals: flush to zero (the device's IP) or IEEE gradual underflow.")
-@click.option("--size", default="512x384", show_default=True, callback=_size, help="Image size WxH.")
+@click.option("--size", type=SIZE, default="512x384", show_default=True, help="Image size WxH (1..8192 each).")
 @click.option("--background", default="0x0000", show_default=True, callback=_colour, help="RGB565 colour where no shape is hit.")
 @click.option("--depth", "visibility", type=click.Choice(["zbuffer", "painter"]), default="zbuffer", show_default=True,
               help="Raster visibility: a depth buffer, or the paper's painter order by centroid distance.")
 @click.option("--depth-image", "depth_path", help="Depth image per frame: .npy (float32 distances) or 16-bit PNG.")
 @click.option("--provenance", "prov_path", help="Which shape made each pixel: .npy (int32, -1 none) or PNG.")
 @click.option("--gif", "gif_path", help="All frames as an animated GIF.")
-@click.option("--apng", "apng_path", help="All frames as an animated PNG (lossless).")
+@click.option("--apng", "apng_path", help="All frames as an animated PNG (lossless; .png or .apng).")
 @click.option("--stats", "show_stats", is_flag=True, help="Print counters, times and the paper's device estimate.")
 @click.option("--profile", type=click.Choice(["rend3r-2022"]), help="Model the original board: every device quirk (docs/device-profile.md).")
 @click.option("--device-quirk", "quirks", multiple=True, metavar="NAME", help="Switch on one device quirk (repeatable); names in docs/device-profile.md.")
@@ -63,7 +55,8 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
                     depth_path, prov_path, gif_path, apng_path, show_stats, profile, quirks, trace_pixels,
                     trace_path) -> None:
     """Run a REND3R PROGRAM (source or memory image) and render its frames."""
-    from .image import frame_path, is_pattern, save_animation, save_depth, save_png, save_provenance
+    from .image import (ANIMATION_KINDS, DATA_KINDS, FRAME_KINDS, check_output, frame_path, is_pattern,
+                        save_animation, save_depth, save_png, save_provenance)
     from .loader import load_program
     from .options import EmuOptions
     from .processor import execute
@@ -81,6 +74,10 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
         raise Rend3rError(f"--trace-pixel: {exc}") from None
     if trace_path and not pixels:
         raise Rend3rError("--trace FILE needs at least one --trace-pixel X,Y")
+    for path, kinds in ((output, FRAME_KINDS), (depth_path, DATA_KINDS), (prov_path, DATA_KINDS),
+                        (gif_path, ANIMATION_KINDS["gif"]), (apng_path, ANIMATION_KINDS["apng"])):
+        if path:
+            check_output(path, kinds, make_parents=is_pattern(path))
     loaded = load_program(program)
     options = EmuOptions(precision=precision, subnormals=subnormals, mode=mode or loaded.mode_hint or "raytrace",
                          width=size[0], height=size[1], background=background, depth=visibility)
@@ -102,11 +99,11 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
 
     def on_frame(frame) -> None:
         if output:
-            save_png(frame.rgb565, frame_path(output, frame.number))
+            save_png(frame.rgb565, frame_path(output, frame.number), make_parents=is_pattern(output))
         if depth_path:
-            save_depth(frame.depth, frame_path(depth_path, frame.number))
+            save_depth(frame.depth, frame_path(depth_path, frame.number), make_parents=is_pattern(depth_path))
         if prov_path:
-            save_provenance(frame.provenance, frame_path(prov_path, frame.number))
+            save_provenance(frame.provenance, frame_path(prov_path, frame.number), make_parents=is_pattern(prov_path))
         if animate:
             rgb_frames.append(frame.rgb565)
 

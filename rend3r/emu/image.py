@@ -3,6 +3,7 @@ provenance images."""
 
 from __future__ import annotations
 
+import io
 import os
 from pathlib import Path
 from typing import Sequence
@@ -28,35 +29,77 @@ def _image(rgb565: np.ndarray):
     return Image.fromarray(rgb565_to_rgb888(rgb565), "RGB")
 
 
-def _save(img, path: PathLike, **kwargs) -> None:
+#: File extension -> encoder format. ``.apng`` is a PNG file with several frames.
+FORMATS = {".png": "PNG", ".apng": "PNG", ".gif": "GIF", ".npy": "NPY"}
+#: The extensions each kind of output accepts.
+FRAME_KINDS = (".png",)
+DATA_KINDS = (".png", ".npy")
+ANIMATION_KINDS = {"gif": (".gif",), "apng": (".png", ".apng")}
+
+
+def check_output(path: PathLike, kinds: Sequence[str], *, make_parents: bool = False) -> str:
+    """The lower-case extension of ``path`` if it is one of ``kinds`` and (unless
+    ``make_parents``) its folder exists; Rend3rError otherwise. Lets a command refuse an
+    output before it spends time rendering."""
     p = Path(path)
-    try:
-        if p.parent and not p.parent.exists():
+    ext = p.suffix.lower()
+    if ext not in kinds:
+        raise Rend3rError(f"{p}: unknown image type {ext or '(no extension)'!r}: use {' or '.join(kinds)}")
+    if not make_parents and not p.parent.is_dir():
+        raise Rend3rError(f"{p}: folder {p.parent} does not exist")
+    return ext
+
+
+def write_image(path: PathLike, image, kinds: Sequence[str] = FRAME_KINDS, *, make_parents: bool = False,
+                **save_kwargs) -> None:
+    """Encode ``image`` in memory by ``path``'s extension and write it atomically.
+
+    ``image`` is a PIL image (``save_kwargs`` go to its encoder) or, for ``.npy``, a numpy
+    array. The extension must be one of ``kinds``; the parent folder must exist unless
+    ``make_parents`` (used for ``{n}`` output patterns). Every failure is a Rend3rError
+    and leaves no partial file behind (:func:`rend3r.fileio.write_atomic`).
+    """
+    from ..fileio import write_atomic
+
+    p = Path(path)
+    ext = check_output(p, kinds, make_parents=make_parents)
+    if make_parents:
+        try:
             p.parent.mkdir(parents=True, exist_ok=True)
-        img.save(p, **kwargs)
+        except OSError as exc:
+            raise Rend3rError(f"{p}: cannot create folder {p.parent}: {exc.strerror or exc}") from None
+    buf = io.BytesIO()
+    try:
+        if FORMATS[ext] == "NPY":
+            np.save(buf, np.asarray(image), allow_pickle=False)
+        else:
+            image.save(buf, format=FORMATS[ext], **save_kwargs)
     except (OSError, ValueError) as exc:
-        raise Rend3rError(f"{p}: cannot write image: {exc}") from None
+        raise Rend3rError(f"{p}: cannot encode image: {exc}") from None
+    write_atomic(p, buf.getvalue())
 
 
-def save_png(rgb565: np.ndarray, path: PathLike) -> None:
+def save_png(rgb565: np.ndarray, path: PathLike, *, make_parents: bool = False) -> None:
     """One frame as an 8-bit RGB PNG."""
-    _save(_image(rgb565), path, format="PNG")
+    write_image(path, _image(rgb565), make_parents=make_parents)
 
 
 def save_animation(frames: Sequence[np.ndarray], path: PathLike, kind: str, frame_ms: int = 100) -> None:
-    """All frames as an animated ``gif`` (256 colours per frame) or ``apng`` (lossless)."""
+    """All frames as an animated ``gif`` (256 colours per frame, ``.gif``) or ``apng``
+    (lossless, ``.png`` or ``.apng``)."""
     if not frames:
         raise Rend3rError(f"{path}: no frames to animate")
     images = [_image(f) for f in frames]
-    fmt = {"gif": "GIF", "apng": "PNG"}[kind]
+    kinds = ANIMATION_KINDS[kind]
     extra = {"disposal": 1} if kind == "gif" else {}
-    _save(images[0], path, format=fmt, save_all=True, append_images=images[1:], duration=frame_ms, loop=0, **extra)
+    write_image(path, images[0], kinds, save_all=True, append_images=images[1:], duration=frame_ms, loop=0,
+                **extra)
 
 
-def save_depth(depth: np.ndarray, path: PathLike) -> None:
-    """``.npy``: the float32 distances; otherwise a 16-bit grey PNG, nearest white, misses black."""
+def save_depth(depth: np.ndarray, path: PathLike, *, make_parents: bool = False) -> None:
+    """``.npy``: the float32 distances; ``.png``: 16-bit grey, nearest white, misses black."""
     if str(path).lower().endswith(".npy"):
-        _save_npy(depth.astype(np.float32), path)
+        write_image(path, depth.astype(np.float32), (".npy",), make_parents=make_parents)
         return
     from PIL import Image
 
@@ -66,13 +109,13 @@ def save_depth(depth: np.ndarray, path: PathLike) -> None:
         lo, hi = float(depth[finite].min()), float(depth[finite].max())
         span = hi - lo if hi > lo else 1.0
         grey[finite] = np.round(65535 - (depth[finite] - lo) / span * 65534).astype(np.uint16)
-    _save(Image.fromarray(grey), path, format="PNG")
+    write_image(path, Image.fromarray(grey), DATA_KINDS, make_parents=make_parents)
 
 
-def save_provenance(provenance: np.ndarray, path: PathLike) -> None:
-    """``.npy``: int32 shape indices (-1 none); otherwise a PNG with one colour per shape."""
+def save_provenance(provenance: np.ndarray, path: PathLike, *, make_parents: bool = False) -> None:
+    """``.npy``: int32 shape indices (-1 none); ``.png``: one colour per shape."""
     if str(path).lower().endswith(".npy"):
-        _save_npy(provenance.astype(np.int32), path)
+        write_image(path, provenance.astype(np.int32), (".npy",), make_parents=make_parents)
         return
     from PIL import Image
 
@@ -80,15 +123,7 @@ def save_provenance(provenance: np.ndarray, path: PathLike) -> None:
     h = (idx + 1) * 2654435761 & 0xFFFFFF  # Knuth's multiplicative hash: distinct neighbours
     rgb = np.stack([(h >> 16) & 0xFF, (h >> 8) & 0xFF, h & 0xFF], axis=-1) | 0x40
     rgb[idx < 0] = 0
-    _save(Image.fromarray(rgb.astype(np.uint8), "RGB"), path, format="PNG")
-
-
-def _save_npy(array: np.ndarray, path: PathLike) -> None:
-    try:
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        np.save(path, array)
-    except OSError as exc:
-        raise Rend3rError(f"{path}: cannot write: {exc.strerror or exc}") from None
+    write_image(path, Image.fromarray(rgb.astype(np.uint8), "RGB"), DATA_KINDS, make_parents=make_parents)
 
 
 def frame_path(pattern: str, number: int) -> str:
@@ -100,4 +135,5 @@ def frame_path(pattern: str, number: int) -> str:
 
 
 def is_pattern(path: str) -> bool:
+    """Whether ``path`` is an output pattern with a ``{n}`` field (its folders are created)."""
     return "{" in path

@@ -22,10 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
+from rend3r.cliutil import parse_size
 from rend3r.emu import EmuOptions, load_program, run_program
 from rend3r.errors import Rend3rError
 from rend3r.golden.catalog import ExampleProgram, discover
-from rend3r.golden.compare import parse_size
 from rend3r.golden.metrics import image_metrics, provenance_metrics
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -3,7 +3,7 @@
 A program's header may carry ``; key: value`` lines read by tools:
 
 - ``frames: N``: frames to render (default 1); programs that loop with ``lr`` need it;
-- ``mode: raster|raytrace``: rendering mode (default: the emulator's hint from the source);
+- ``mode: raytrace|raster|hybrid``: rendering mode (default: the emulator's hint from the source);
 - ``test-size: WxH``: a smaller image size for the test suite, for scenes too slow to test
   at the golden size.
 """
@@ -13,6 +13,9 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
+
+from ..cliutil import parse_size
+from ..errors import Rend3rError
 
 _HEADER_KEY = re.compile(r"^\s*;\s*(frames|mode|test-size)\s*:\s*(\S+)\s*$", re.IGNORECASE)
 
@@ -35,15 +38,24 @@ class ExampleProgram:
         return self.name if self.frames == 1 else f"{self.name}.{frame:03d}"
 
 
-def _parse_size(text: str) -> tuple[int, int]:
-    w, h = text.lower().split("x")
-    return int(w), int(h)
+MODES = ("raytrace", "raster", "hybrid")
 
 
 def read_header(path: Path) -> ExampleProgram:
-    """Metadata from the leading comment block of ``path``."""
+    """Metadata from the leading comment block of ``path``.
+
+    Rend3rError (``path:line: ...``) for a file that is not UTF-8 text or a header value
+    that is malformed; an unreadable header is never ignored.
+    """
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except OSError as exc:
+        raise Rend3rError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        line = exc.object[: exc.start].count(b"\n") + 1
+        raise Rend3rError(f"{path}:{line}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x})") from None
     frames, mode, test_size = 1, None, None
-    for line in path.read_text(encoding="utf-8").splitlines():
+    for number, line in enumerate(text.splitlines(), 1):
         stripped = line.strip()
         if stripped and not stripped.startswith((";", "//")):
             break
@@ -51,15 +63,28 @@ def read_header(path: Path) -> ExampleProgram:
         if not m:
             continue
         key, value = m.group(1).lower(), m.group(2)
+        where = f"{path}:{number}"
         if key == "frames":
+            if not value.isascii() or not value.isdigit() or int(value) < 1:
+                raise Rend3rError(f"{where}: frames: expected a whole number >= 1, not {value!r}")
             frames = int(value)
         elif key == "mode":
             mode = value.lower()
+            if mode not in MODES:
+                raise Rend3rError(f"{where}: mode: expected {', '.join(MODES)}, not {value!r}")
         else:
-            test_size = _parse_size(value)
+            try:
+                test_size = parse_size(value)
+            except ValueError as exc:
+                raise Rend3rError(f"{where}: test-size: {exc}") from None
     return ExampleProgram(path, frames, mode, test_size)
+
+
+def program_paths(directory: Path) -> list[Path]:
+    """Every ``*.asm`` directly in ``directory``, sorted by name."""
+    return sorted(directory.glob("*.asm"))
 
 
 def discover(directory: Path) -> list[ExampleProgram]:
     """Every ``*.asm`` directly in ``directory`` (sorted by name), with its metadata."""
-    return [read_header(p) for p in sorted(directory.glob("*.asm"))]
+    return [read_header(p) for p in program_paths(directory)]

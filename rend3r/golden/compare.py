@@ -2,27 +2,18 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import click
 import numpy as np
 
+from ..cliutil import SIZE
 from ..errors import Rend3rError
 from .metrics import ImageMetrics, as_rgb888, diff_image, image_metrics
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 DEVICE_SIZE = (512, 384)
-
-
-def parse_size(text: str) -> tuple[int, int]:
-    """``"WxH"`` -> (W, H)."""
-    try:
-        w, h = (int(part) for part in text.lower().split("x"))
-    except ValueError:
-        raise Rend3rError(f"bad size {text!r}: expected WxH, e.g. 512x384") from None
-    if w <= 0 or h <= 0:
-        raise Rend3rError(f"bad size {text!r}: width and height must be positive")
-    return w, h
 
 
 def load_image(path: Path, size: tuple[int, int] | None = None) -> np.ndarray:
@@ -52,17 +43,22 @@ def load_image(path: Path, size: tuple[int, int] | None = None) -> np.ndarray:
 
 
 def save_rgb888_png(rgb: np.ndarray, path: Path) -> None:
-    """Write an (H, W, 3) uint8 image as PNG, creating parent folders."""
+    """Write an (H, W, 3) uint8 image as PNG, atomically; its folder must exist."""
     from PIL import Image
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    Image.fromarray(np.ascontiguousarray(rgb), mode="RGB").save(path)
+    from ..emu.image import write_image
+
+    write_image(path, Image.fromarray(np.ascontiguousarray(rgb), mode="RGB"))
 
 
 def compare_files(
     a: Path, b: Path, diff: Path | None = None, size: tuple[int, int] | None = None
 ) -> ImageMetrics:
     """Metrics of ``b`` against reference ``a``; writes the diff picture when asked."""
+    if diff is not None:
+        from ..emu.image import check_output
+
+        check_output(diff, (".png",))
     x = as_rgb888(load_image(a, size))
     y = as_rgb888(load_image(b, size))
     if x.shape != y.shape:
@@ -72,28 +68,38 @@ def compare_files(
     return image_metrics(x, y)
 
 
+def _psnr(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
+    if value is not None and math.isnan(value):
+        raise click.BadParameter("must be a number of dB, not nan")
+    return value
+
+
 @click.command("compare")
 @click.argument("a", type=click.Path(path_type=Path, dir_okay=False))
 @click.argument("b", type=click.Path(path_type=Path, dir_okay=False))
 @click.option("--diff", "diff_path", type=click.Path(path_type=Path, dir_okay=False), help="Write a diff PNG (changed pixels magenta).")
 @click.option("--max-channel", type=click.IntRange(0, 255), default=0, show_default=True, help="Largest allowed channel difference (RGB888).")
 @click.option("--max-share", type=click.FloatRange(0.0, 1.0), default=None, help="Largest allowed share of differing pixels (0..1).")
-@click.option("--min-psnr", type=float, default=None, help="Smallest allowed PSNR in dB.")
-@click.option("--size", "size_text", default=None, metavar="WxH", help="Size of raw RGB565 inputs (default 512x384).")
+@click.option("--min-psnr", type=float, default=None, callback=_psnr, help="Smallest allowed PSNR in dB (inf: identical).")
+@click.option("--size", type=SIZE, default=None, help="Size of raw RGB565 inputs (default 512x384).")
 def compare_command(
-    a: Path, b: Path, diff_path: Path | None, max_channel: int, max_share: float | None, min_psnr: float | None, size_text: str | None
+    a: Path, b: Path, diff_path: Path | None, max_channel: int, max_share: float | None, min_psnr: float | None,
+    size: tuple[int, int] | None
 ) -> None:
     """Compare image B against reference A and print the metrics.
 
-    A and B are PNGs or raw little-endian RGB565 frame buffers. Exit status 0 when B is
-    within every given tolerance (by default: identical), 1 otherwise.
+    A and B are PNGs or raw little-endian RGB565 frame buffers. Exit status, as cmp and
+    diff: 0 when B is within every given tolerance (by default: identical), 1 when it is
+    not, 2 on trouble (a missing or unreadable file, sizes that differ, a bad option).
 
     \b
     Example:
       rend3r compare programs/golden/sphere.png out/sphere.png --max-channel 8 --diff d.png
     """
-    size = parse_size(size_text) if size_text else None
-    m = compare_files(a, b, diff_path, size)
+    try:
+        m = compare_files(a, b, diff_path, size)
+    except Rend3rError as exc:
+        raise Rend3rError(str(exc), exit_code=2) from None
     ok = m.within(max_channel, max_share, min_psnr)
     click.echo(m.describe())
     if diff_path is not None:

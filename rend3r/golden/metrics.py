@@ -12,15 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
-def rgb565_to_rgb888(fb: np.ndarray) -> np.ndarray:
-    """Widen an (H, W) RGB565 frame buffer to (H, W, 3) uint8 by bit replication."""
-    v = np.asarray(fb, dtype=np.uint16)
-    r5 = (v >> 11) & 0x1F
-    g6 = (v >> 5) & 0x3F
-    b5 = v & 0x1F
-    rgb = np.stack([(r5 << 3) | (r5 >> 2), (g6 << 2) | (g6 >> 4), (b5 << 3) | (b5 >> 2)], axis=-1)
-    return rgb.astype(np.uint8)
+from ..emu.image import rgb565_to_rgb888
 
 
 def as_rgb888(image: np.ndarray) -> np.ndarray:

@@ -10,9 +10,9 @@ from typing import TYPE_CHECKING
 
 import click
 
+from ..cliutil import SIZE
 from ..errors import Rend3rError
-from .catalog import ExampleProgram, discover
-from .compare import parse_size
+from .catalog import ExampleProgram, program_paths, read_header
 
 if TYPE_CHECKING:
     from ..emu import EmuOptions, Frame
@@ -44,22 +44,26 @@ def render_all(
     """
     from ..emu.image import save_png
 
-    programs = discover(programs_dir)
-    if not programs:
+    paths = program_paths(programs_dir)
+    if not paths:
         raise Rend3rError(f"no *.asm programs in {programs_dir}")
-    out_dir.mkdir(parents=True, exist_ok=True)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise Rend3rError(f"{out_dir}: cannot create the output folder: {exc.strerror or exc}") from None
     failed: list[str] = []
-    for n, program in enumerate(programs, 1):
-        prefix = f"[{n}/{len(programs)}] {program.name}:"
+    for n, path in enumerate(paths, 1):
+        prefix = f"[{n}/{len(paths)}] {path.stem}:"
         start = time.perf_counter()
         try:
+            program = read_header(path)
             frames = render_example(program, options)
+            for i, frame in enumerate(frames):
+                save_png(frame.rgb565, out_dir / f"{program.frame_name(i)}.png")
         except Rend3rError as exc:
             echo(f"{prefix} FAILED: {exc}")
-            failed.append(program.name)
+            failed.append(path.stem)
             continue
-        for i, frame in enumerate(frames):
-            save_png(frame.rgb565, out_dir / f"{program.frame_name(i)}.png")
         elapsed = time.perf_counter() - start
         plural = "s" if len(frames) != 1 else ""
         echo(
@@ -75,13 +79,14 @@ def render_all(
 @click.option("-o", "--out", "out_dir", type=click.Path(path_type=Path, file_okay=False), required=True, help="Folder for the PNGs.")
 @click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormal handling.")
-@click.option("--size", "size_text", default="512x384", show_default=True, metavar="WxH", help="Image size.")
-def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnormals: str, size_text: str) -> None:
+@click.option("--size", type=SIZE, default="512x384", show_default=True, help="Image size (1..8192 each).")
+def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnormals: str, size: tuple[int, int]) -> None:
     """Render every PROGRAMS_DIR/*.asm (default: programs) to PNGs in OUT.
 
     Each program's header sets its frame count (``; frames: N``) and mode. Files are
     named after the program, with the frame number for animations
-    (``animation.000.png``). Exit status 1 if any program failed.
+    (``animation.000.png``). A program that fails (a bad header, an error while
+    rendering or writing) is reported and the others still render; exit status 1 then.
 
     \b
     Example:
@@ -91,7 +96,7 @@ def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnor
 
     if not programs_dir.is_dir():
         raise Rend3rError(f"{programs_dir} is not a folder")
-    width, height = parse_size(size_text)
+    width, height = size
     options = EmuOptions(precision=precision, subnormals=subnormals, width=width, height=height)
     failed = render_all(programs_dir, out_dir, options, echo=click.echo)
     if failed:

@@ -34,7 +34,7 @@ def test_difference_beyond_tolerance_exit_1_and_diff(tmp_path: Path) -> None:
     other = rgb.copy()
     other[2, 3] = (0, 40, 0)
     a, b = _png(tmp_path / "a.png", rgb), _png(tmp_path / "b.png", other)
-    diff = tmp_path / "sub" / "d.png"
+    diff = tmp_path / "d.png"
     r = CliRunner().invoke(main, ["compare", str(a), str(b), "--diff", str(diff)])
     assert r.exit_code == 1, r.output
     assert "max channel difference 40" in r.output and "NOT within tolerance" in r.output
@@ -65,16 +65,38 @@ def test_raw_device_size_needs_no_size(tmp_path: Path) -> None:
     assert r.exit_code == 1 and "differing pixels 1/196608" in r.output
 
 
-def test_errors_are_clean(tmp_path: Path) -> None:
+def test_errors_exit_2_like_cmp(tmp_path: Path) -> None:
     odd = tmp_path / "odd.bin"
     odd.write_bytes(b"\x00" * 10)
     r = CliRunner().invoke(main, ["compare", str(odd), str(odd)])
-    assert r.exit_code == 1 and "rend3r: error:" in r.output and "--size" in r.output
+    assert r.exit_code == 2 and "rend3r: error:" in r.output and "--size" in r.output
     r = CliRunner().invoke(main, ["compare", str(tmp_path / "missing.png"), str(odd)])
-    assert r.exit_code == 1 and "cannot read" in r.output
+    assert r.exit_code == 2 and "cannot read" in r.output
+    garbage = tmp_path / "garbage.png"
+    garbage.write_bytes(b"\x89PNG\r\n\x1a\n" + b"junk" * 10)
+    r = CliRunner().invoke(main, ["compare", str(garbage), str(garbage)])
+    assert r.exit_code == 2 and "cannot read PNG" in r.output
     a = _png(tmp_path / "a.png", np.zeros((2, 2, 3), np.uint8))
     b = _png(tmp_path / "b.png", np.zeros((2, 3, 3), np.uint8))
     r = CliRunner().invoke(main, ["compare", str(a), str(b)])
-    assert r.exit_code == 1 and "sizes differ" in r.output
-    r = CliRunner().invoke(main, ["compare", str(a), str(b), "--size", "3by2"])
-    assert r.exit_code == 1 and "bad size" in r.output
+    assert r.exit_code == 2 and "sizes differ" in r.output
+    for size in ("3by2", "0x2", "100000x100000"):
+        r = CliRunner().invoke(main, ["compare", str(a), str(b), "--size", size])
+        assert r.exit_code == 2 and "--size" in r.output, (size, r.output)
+    assert "2 on trouble" in CliRunner().invoke(main, ["compare", "--help"]).output
+
+
+def test_min_psnr_nan_is_rejected(tmp_path: Path) -> None:
+    a = _png(tmp_path / "a.png", np.zeros((2, 2, 3), np.uint8))
+    r = CliRunner().invoke(main, ["compare", str(a), str(a), "--min-psnr", "nan"])
+    assert r.exit_code == 2 and "nan" in r.output
+    r = CliRunner().invoke(main, ["compare", str(a), str(a), "--min-psnr", "inf"])
+    assert r.exit_code == 0, r.output
+
+
+def test_diff_path_is_checked_before_comparing(tmp_path: Path) -> None:
+    a = _png(tmp_path / "a.png", np.zeros((2, 2, 3), np.uint8))
+    for diff, why in ((tmp_path / "sub" / "d.png", "does not exist"), (tmp_path / "d.txt", "unknown image type")):
+        r = CliRunner().invoke(main, ["compare", str(a), str(a), "--diff", str(diff)])
+        assert r.exit_code == 2 and why in r.output, r.output
+        assert not diff.exists()

@@ -6,6 +6,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+import pytest
 from click.testing import CliRunner
 from PIL import Image
 
@@ -47,3 +48,36 @@ def test_empty_or_missing_folder(tmp_path: Path) -> None:
     assert r.exit_code == 1 and "no *.asm programs" in r.output
     r = CliRunner().invoke(main, ["render-all", str(tmp_path / "missing"), "-o", str(tmp_path / "o")])
     assert r.exit_code == 1 and "is not a folder" in r.output
+
+
+@pytest.mark.parametrize(
+    ("header", "why"),
+    [
+        ("; frames: abc\n", "bad.asm:2: frames: expected a whole number"),
+        ("; frames: 0\n", "bad.asm:2: frames: expected a whole number"),
+        ("; test-size: abc\n", "bad.asm:2: test-size: expected WIDTHxHEIGHT"),
+        ("; test-size: 100000x1\n", "bad.asm:2: test-size: width and height must be 1..8192"),
+        ("; mode: bogus\n", "bad.asm:2: mode: expected raytrace, raster, hybrid"),
+    ],
+)
+def test_bad_header_fails_that_program_only(tmp_path: Path, header: str, why: str) -> None:
+    (tmp_path / "bad.asm").write_text("; bad.asm\n" + header + "nr\nnf\ner\n", encoding="utf-8")
+    shutil.copy(PROGRAMS_DIR / "sphere.asm", tmp_path / "sphere.asm")
+    out = tmp_path / "out"
+    r = CliRunner().invoke(main, ["render-all", str(tmp_path), "-o", str(out), "--size", "8x6"])
+    assert r.exit_code == 1, r.output
+    assert "[1/2] bad: FAILED" in r.output and why in r.output, r.output
+    assert (out / "sphere.png").exists()
+
+
+def test_binary_program_fails_cleanly(tmp_path: Path) -> None:
+    (tmp_path / "bin.asm").write_bytes(b"; ok\n\xff\xfe\x00binary")
+    r = CliRunner().invoke(main, ["render-all", str(tmp_path), "-o", str(tmp_path / "o"), "--size", "8x6"])
+    assert r.exit_code == 1 and "bin.asm:2: not UTF-8 text (byte 0xff)" in r.output, r.output
+
+
+def test_huge_size_is_a_usage_error(tmp_path: Path) -> None:
+    shutil.copy(PROGRAMS_DIR / "sphere.asm", tmp_path / "sphere.asm")
+    r = CliRunner().invoke(main, ["render-all", str(tmp_path), "-o", str(tmp_path / "o"), "--size", "100000x100000"])
+    assert r.exit_code == 2 and "1..8192" in r.output
+    assert not (tmp_path / "o").exists()

@@ -79,9 +79,14 @@ def parse_record(text: str, where: str, line: int) -> Record:
 def read_trace(path: Path) -> list[Record]:
     """All records of a trace file, in file order (blank lines are skipped)."""
     try:
-        text = path.read_text(encoding="utf-8")
+        data = path.read_bytes()
     except OSError as exc:
-        raise Rend3rError(f"cannot read {path}: {exc.strerror}") from None
+        raise Rend3rError(f"cannot read {path}: {exc.strerror or exc}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise Rend3rError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x}): not a trace") from None
     return [
         parse_record(line, f"{path}:{n}", n) for n, line in enumerate(text.splitlines(), 1) if line.strip()
     ]
@@ -125,14 +130,20 @@ def first_divergence(a: list[Record], b: list[Record]) -> str | None:
 @click.argument("a", type=click.Path(dir_okay=False, path_type=Path))
 @click.argument("b", type=click.Path(dir_okay=False, path_type=Path))
 def trace_diff_command(a: Path, b: Path) -> None:
-    """Compare two pixel traces (docs/trace.md); exit 1 at the first divergence.
+    """Compare two pixel traces (docs/trace.md) and report the first divergence.
+
+    Exit status, as cmp and diff: 0 when the traces agree, 1 when they differ, 2 on
+    trouble (a missing, unreadable or malformed file).
 
     \b
     Example:
       rend3r emulate scene.asm -o f.png --trace-pixel 252,188 --trace emu.jsonl
       rend3r trace-diff emu.jsonl rtl.jsonl
     """
-    ra, rb = read_trace(a), read_trace(b)
+    try:
+        ra, rb = read_trace(a), read_trace(b)
+    except Rend3rError as exc:
+        raise Rend3rError(str(exc), exit_code=2) from None
     msg = first_divergence(ra, rb)
     if msg is None:
         click.echo(f"traces agree: {len(ra)} values")

@@ -66,6 +66,6 @@ def test_malformed_lines_are_clean_errors(tmp_path):
     bad = tmp_path / "bad.jsonl"
     bad.write_text('{"pixel": [1, 2], "stage": "b", "hex": "zz", "dec": 1}\n')
     res = CliRunner().invoke(main, ["trace-diff", a, str(bad)])
-    assert res.exit_code == 1 and "bad.jsonl:1" in res.output and "Traceback" not in res.output
+    assert res.exit_code == 2 and "bad.jsonl:1" in res.output and "Traceback" not in res.output
     res = CliRunner().invoke(main, ["trace-diff", a, str(tmp_path / "missing.jsonl")])
-    assert res.exit_code == 1 and "cannot read" in res.output
+    assert res.exit_code == 2 and "cannot read" in res.output

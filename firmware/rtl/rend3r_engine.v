@@ -49,6 +49,7 @@ module rend3r_engine #(
                      T_ACK = 8'h80, T_NACK = 8'h81;
     localparam [7:0] N_VERSION = 1, N_TYPE = 2, N_FIELDS = 3, N_NO_LOAD = 4,
                      N_RANGE = 5, N_MISMATCH = 6, N_TOO_LARGE = 7;
+    localparam [AW-1:0] FOUR = 4;         // header words before the payload
     localparam [2:0] S_RX = 0, S_DECIDE = 1, S_VERIFY = 2, S_CLEAR = 3, S_REPLY = 4;
 
     reg [2:0]  state;
@@ -81,7 +82,7 @@ module rend3r_engine #(
     wire data_fields_ok = f_count >= 1 && f_count <= 256 && {2'b00, f_length} == {f_count, 2'b00};
     wire info_fields_ok = f_count == 0 && f_offset == 0 && f_length == 8;
     wire ctrl_fields_ok = f_count == 0 && f_offset == 0 && f_length == 0;
-    wire [32:0] data_end = {1'b0, f_offset} + f_count;
+    wire [32:0] data_end = {1'b0, f_offset} + {17'd0, f_count};
     wire data_in_range  = data_end <= {1'b0, st_words};
     // DATA of the open load: its payload streams straight into staging (protocol.md step 3)
     wire data_writes = f_version == 1 && f_type == T_DATA && data_fields_ok && staging &&
@@ -100,6 +101,7 @@ module rend3r_engine #(
     reg [AW:0] walk;                    // next word address to read or clear
     reg [1:0]  pending;                 // staging reads in flight (the RAM has 2 cycles' latency)
     reg [31:0] vcrc;
+    wire [31:0] walk32 = {{(31 - AW){1'b0}}, walk};
 
     wire [191:0] status_bytes = {active_words, active_crc, frames_rendered, 7'd0, running,
                                  7'd0, staging, active_load, malformed, loads};
@@ -115,7 +117,7 @@ module rend3r_engine #(
                 14: reply_at = f_type;
                 15: reply_at = rep_code;
                 default:
-                    if (i < 12) reply_at = hdr[i];  // load, seq, count, offset of the request
+                    if (i < 12) reply_at = hdr[i[3:0]];  // load, seq, count, offset of the request
                     else if (rep_plen == 4) reply_at = MAX_WORDS[8 * (19 - i) +: 8];
                     else reply_at = status_bytes[8 * (39 - i) +: 8];
             endcase
@@ -169,16 +171,16 @@ module rend3r_engine #(
                 end else if (idx < 16) begin
                     hdr[idx[3:0]] <= in_data;
                     crc <= crc32_byte(crc, in_data);
-                end else if (idx < body_end) begin
+                end else if ({1'b0, idx} < body_end) begin
                     crc <= crc32_byte(crc, in_data);
                     info <= {info[55:0], in_data};
                     part <= {part[15:0], in_data};
                     if (data_writes && idx[1:0] == 2'd3) begin
                         mem_we <= 1'b1;
-                        mem_addr <= {~bank, f_offset[AW-1:0] + idx[AW+1:2] - 3'd4};
+                        mem_addr <= {~bank, f_offset[AW-1:0] + idx[AW+1:2] - FOUR};
                         mem_wdata <= {part, in_data};
                     end
-                end else if (idx < body_end + 4) begin
+                end else if ({1'b0, idx} < body_end + 17'd4) begin
                     rx_crc <= {rx_crc[23:0], in_data};
                 end
             end
@@ -186,7 +188,7 @@ module rend3r_engine #(
                 dropping <= 1'b0;
                 if (state == S_RX && receiving) begin
                     receiving <= 1'b0;
-                    if (in_err || idx < 20 || {1'b0, idx} < body_end + 4 || ~crc != rx_crc)
+                    if (in_err || idx < 20 || {1'b0, idx} < body_end + 17'd4 || ~crc != rx_crc)
                         malformed <= malformed + 1'b1;
                     else
                         state <= S_DECIDE;
@@ -261,13 +263,13 @@ module rend3r_engine #(
             end
 
             S_VERIFY: begin  // CRC-32 over staging words 0..N-1, one word per cycle
-                pending <= {pending[0], {1'b0, walk} < st_words};
-                if ({1'b0, walk} < st_words) begin
+                pending <= {pending[0], walk32 < st_words};
+                if (walk32 < st_words) begin
                     mem_addr <= {~bank, walk[AW-1:0]};
                     walk <= walk + 1'b1;
                 end
                 if (pending[1]) vcrc <= crc32_word(vcrc, mem_rdata);
-                if (pending == 2'b00 && {1'b0, walk} >= st_words) begin
+                if (pending == 2'b00 && walk32 >= st_words) begin
                     if (~vcrc == st_crc) begin
                         bank <= ~bank;
                         staging <= 1'b0;

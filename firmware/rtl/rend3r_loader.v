@@ -87,8 +87,10 @@ module rend3r_loader #(
     wire          reply_start, reply_busy;
     wire [5:0]    reply_len, reply_idx;
     wire [7:0]    reply_byte;
+    /* verilator lint_off UNUSEDSIGNAL */  // reported by STATUS only
     wire [31:0]   active_crc;
     wire [15:0]   active_load;
+    /* verilator lint_on UNUSEDSIGNAL */
     rend3r_engine #(.AW(AW)) u_engine (
         .clk(clk), .rst(rst), .in_valid(in_valid), .in_data(in_data), .in_first(in_first),
         .in_last(in_last), .in_err(in_err),

@@ -25,13 +25,13 @@ module rmii_rx #(
     localparam [1:0] S_HUNT = 0, S_PREAMBLE = 1, S_DATA = 2;
     reg [1:0]  state;
     reg [1:0]  dibit;      // dibits of the current byte already shifted in
-    reg [7:0]  shift;
+    reg [5:0]  shift;      // upper six bits of the byte being shifted in
     reg [10:0] count;      // bytes of the frame so far (saturating)
     reg [31:0] fcs;
     reg        dst_ok, bcast, pass;
     reg [47:0] src;
     reg [7:0]  type_hi;
-    wire [7:0] byte_in = {rxd, shift[7:2]};
+    wire [7:0] byte_in = {rxd, shift};
 
     always @(posedge clk) begin
         out_valid <= 1'b0;
@@ -62,7 +62,7 @@ module rmii_rx #(
                     out_err <= (dibit != 0) || fcs != 32'hDEBB20E3;
                 end
             end else begin
-                shift <= byte_in;
+                shift <= byte_in[7:2];
                 dibit <= dibit + 1'b1;
                 if (dibit == 2'd3) begin
                     fcs <= crc32_byte(fcs, byte_in);

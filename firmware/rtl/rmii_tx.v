@@ -26,23 +26,22 @@ module rmii_tx #(
     reg [5:0]  n;
     reg [47:0] dst;
     wire [6:0] fcs_at = 7'd8 + 7'd14 + ((n < 46) ? 7'd46 : {1'b0, n});  // first FCS byte
-    assign idx = pos - 7'd22;
+    assign idx = pos[5:0] - 6'd22;  // reply byte at frame position pos (mod 64)
     assign busy = active;
 
-    // the byte at frame position p (valid for p < fcs_at)
-    function [7:0] frame_at;
-        input [6:0] p;
-        begin
-            if (p < 7) frame_at = 8'h55;
-            else if (p == 7) frame_at = 8'hD5;
-            else if (p < 14) frame_at = dst[8 * (13 - p) +: 8];
-            else if (p < 20) frame_at = SOURCE_MAC[8 * (19 - p) +: 8];
-            else if (p == 20) frame_at = ETHERTYPE[15:8];
-            else if (p == 21) frame_at = ETHERTYPE[7:0];
-            else if (p - 22 < n) frame_at = buf_byte;
-            else frame_at = 8'h00;
-        end
-    endfunction
+    // the byte at frame position pos: header, reply, padding, then the FCS
+    reg [7:0] next_byte;
+    always @* begin
+        if (pos >= fcs_at) next_byte = ~crc[8 * (pos - fcs_at) +: 8];
+        else if (pos < 7) next_byte = 8'h55;
+        else if (pos == 7) next_byte = 8'hD5;
+        else if (pos < 14) next_byte = dst[8 * (13 - pos) +: 8];
+        else if (pos < 20) next_byte = SOURCE_MAC[8 * (19 - pos) +: 8];
+        else if (pos == 20) next_byte = ETHERTYPE[15:8];
+        else if (pos == 21) next_byte = ETHERTYPE[7:0];
+        else if (pos - 7'd22 < {1'b0, n}) next_byte = buf_byte;
+        else next_byte = 8'h00;
+    end
 
     always @(posedge clk) begin
         if (rst) begin
@@ -62,14 +61,10 @@ module rmii_tx #(
             end
         end else begin
             if (dibit == 0) begin  // load the next byte
-                if (pos < fcs_at) begin
-                    cur = frame_at(pos);
-                    if (pos >= 8) crc <= crc32_byte(crc, cur);
-                end else begin
-                    cur = ~crc[8 * (pos - fcs_at) +: 8];
-                end
+                cur <= next_byte;
+                if (pos >= 8 && pos < fcs_at) crc <= crc32_byte(crc, next_byte);
                 tx_en <= (pos < fcs_at + 4);
-                txd <= (pos < fcs_at + 4) ? cur[1:0] : 2'b00;
+                txd <= (pos < fcs_at + 4) ? next_byte[1:0] : 2'b00;
             end else begin
                 tx_en <= (pos < fcs_at + 4);
                 txd <= (pos < fcs_at + 4) ? cur[2 * dibit +: 2] : 2'b00;

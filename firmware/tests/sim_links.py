@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import zlib
 
-from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge
+from cocotb.triggers import FallingEdge, RisingEdge, Timer
+from cocotb.utils import get_sim_time
 
 from rend3r.transport import cobs
 from rend3r.transport.links import DEFAULT_ETHERTYPE, ethernet_frame, parse_mac
@@ -18,6 +19,7 @@ from rend3r.transport.protocol import Frame, FrameError, decode
 DEVICE_MAC = parse_mac("69:69:5a:06:54:91")
 HOST_MAC = parse_mac("02:00:00:00:00:01")  # the --pcap source address
 IFG_BYTES = 12  # minimum inter-frame gap
+CLOCK_NS = 20  # the 50 MHz RMII reference clock
 PREAMBLE = b"\x55" * 7 + b"\xd5"
 
 
@@ -54,6 +56,7 @@ class Pins:
         self.cpb = clks_per_bit
         self.replies: list[Frame] = []  # decoded replies, in arrival order, both links
         self.bad_replies = 0  # reply bytes that did not decode
+        self.reply_cycles: list[int] = []  # clock cycle at which each reply was complete
 
     def start_monitors(self) -> None:
         import cocotb
@@ -70,27 +73,32 @@ class Pins:
             await FallingEdge(dut.clk)
         dut.rmii_crs_dv.value = 0
         dut.rmii_rxd.value = 0
-        await ClockCycles(dut.clk, 4 * gap_bytes, rising=False)
+        await Timer(CLOCK_NS * 4 * gap_bytes, "ns")
 
     async def send_uart(self, data: bytes) -> None:
         """Drive the UART rx pin with 8N1 bits at clks_per_bit clocks each."""
         dut = self.dut
-        for bit in uart_bits(data):
+        await FallingEdge(dut.clk)
+        for bit in uart_bits(data):  # Timer, not ClockCycles: one wake-up per bit, not per clock
             dut.uart_rx.value = bit
-            await ClockCycles(dut.clk, self.cpb, rising=False)
+            await Timer(CLOCK_NS * self.cpb, "ns")
+
+    def now(self) -> int:
+        """Simulated time in cycles of the 50 MHz clock."""
+        return int(get_sim_time("ns")) // CLOCK_NS
 
     def _accept(self, data: bytes) -> None:
         try:
             self.replies.append(decode(data))
+            self.reply_cycles.append(self.now())
         except FrameError:
             self.bad_replies += 1
 
     async def _watch_rmii(self) -> None:
         dut = self.dut
         while True:
+            await RisingEdge(dut.rmii_tx_en)
             await RisingEdge(dut.clk)
-            if not dut.rmii_tx_en.value:
-                continue
             bits: list[int] = []
             while dut.rmii_tx_en.value:
                 bits.append(int(dut.rmii_txd.value))
@@ -111,12 +119,12 @@ class Pins:
         buf = bytearray()
         while True:
             await FallingEdge(dut.uart_tx)
-            await ClockCycles(dut.clk, self.cpb // 2)
+            await Timer(CLOCK_NS * (self.cpb // 2), "ns")
             byte = 0
             for i in range(8):
-                await ClockCycles(dut.clk, self.cpb)
+                await Timer(CLOCK_NS * self.cpb, "ns")
                 byte |= int(dut.uart_tx.value) << i
-            await ClockCycles(dut.clk, self.cpb)  # stop bit centre
+            await Timer(CLOCK_NS * self.cpb, "ns")  # stop bit centre
             if byte:
                 buf.append(byte)
             elif buf:
@@ -130,10 +138,11 @@ class Pins:
         """The active bank's first ``words`` words, through the processor's read port."""
         dut = self.dut
         out = []
-        for a in range(words):
+        for a in range(words):  # prog_clk is pulsed here only: a free-running clock costs time
             dut.prog_addr.value = a
-            await RisingEdge(dut.clk)
-            await RisingEdge(dut.clk)
-            await FallingEdge(dut.clk)
+            await Timer(5, "ns")
+            dut.prog_clk.value = 1
+            await Timer(5, "ns")
+            dut.prog_clk.value = 0
             out.append(int(dut.prog_data.value))
         return out

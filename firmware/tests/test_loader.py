@@ -13,7 +13,7 @@ from pathlib import Path
 
 import cocotb
 from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles
+from cocotb.triggers import ClockCycles, Timer
 
 from rend3r.transport.device import DeviceCore
 from rend3r.transport.protocol import (
@@ -21,7 +21,7 @@ from rend3r.transport.protocol import (
 )
 from rend3r.transport.session import load_frames
 
-from sim_links import DEVICE_MAC, Pins, eth_for, serial_bytes, wire_bytes
+from sim_links import CLOCK_NS, DEVICE_MAC, Pins, eth_for, serial_bytes, wire_bytes
 
 REPO = Path(__file__).resolve().parents[2]
 AW = int(os.environ.get("LOADER_AW", "10"))
@@ -39,12 +39,12 @@ def assembled(name: str) -> list[int]:
 async def bring_up(dut) -> Pins:
     """Clock, reset, idle lines, monitors."""
     cocotb.start_soon(Clock(dut.clk, 20, unit="ns").start())  # 50 MHz
-    cocotb.start_soon(Clock(dut.prog_clk, 10, unit="ns").start())  # the processor's 100 MHz
     dut.rst.value = 1
     dut.rmii_crs_dv.value = 0
     dut.rmii_rxd.value = 0
     dut.uart_rx.value = 1
     dut.prog_addr.value = 0
+    dut.prog_clk.value = 0
     dut.frames_rendered.value = 0
     await ClockCycles(dut.clk, 4)
     dut.rst.value = 0
@@ -84,12 +84,13 @@ class Sender:
 
     async def reply_to(self, f: Frame) -> Frame | None:
         """The reply matching ``f`` (load, seq, ref), or None after the timeout."""
-        for _ in range(self.timeout // 16):
+        step = 16 if self.link == "rmii" else CPB  # polling interval in cycles
+        for _ in range(self.timeout // step + 1):
             for r in self.pins.replies:
                 if (r.load, r.seq, r.ref) == (f.load, f.seq, f.type):
                     self.pins.replies.remove(r)
                     return r
-            await ClockCycles(self.pins.dut.clk, 16)
+            await Timer(CLOCK_NS * step, "ns")
         return None
 
     async def request(self, f: Frame, tries: int = 10) -> Frame:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import shutil
 import sys
 from pathlib import Path
@@ -18,21 +17,19 @@ if shutil.which("iverilog") is None or shutil.which("vvp") is None:
 runner_mod = pytest.importorskip("cocotb_tools.runner", reason="cocotb 2.x is not installed: pip install cocotb")
 
 
-def build_and_run(tmp: Path, params: dict[str, int], env: dict[str, str], testcase: str | None = None) -> None:
+def build_and_run(tmp: Path, params: dict[str, int], env: dict[str, str]) -> None:
     """Build rend3r_loader with ``params`` and run firmware/tests/test_loader.py against it."""
     runner = runner_mod.get_runner("icarus")
     runner.build(sources=RTL, includes=[FIRMWARE / "rtl"], hdl_toplevel="rend3r_loader",
                  parameters=params, build_dir=tmp, timescale=("1ns", "1ps"))
-    sys.path.insert(0, str(FIRMWARE / "tests"))
+    sys.path.insert(0, str(FIRMWARE / "tests"))  # the runner passes sys.path to the simulator
     try:
         results = runner.test(test_module="test_loader", hdl_toplevel="rend3r_loader",
-                              testcase=testcase, build_dir=tmp, test_dir=tmp,
-                              extra_env={**env, "PYTHONPATH": os.pathsep.join(
-                                  [str(FIRMWARE / "tests"), *sys.path])})
+                              build_dir=tmp, test_dir=tmp, extra_env=env)
     finally:
         sys.path.remove(str(FIRMWARE / "tests"))
-    failed = runner_mod.get_results(results)[1]
-    assert failed == 0, f"{failed} cocotb test(s) failed; see {tmp}"
+    tests, failed = runner_mod.get_results(results)
+    assert tests == 6 and failed == 0, f"{failed} of {tests} cocotb tests failed; see {tmp}"
 
 
 def test_loader_cosim(tmp_path: Path) -> None:

@@ -7,13 +7,12 @@ starting a new program (or stopping) supersedes the running one at its next fram
 from __future__ import annotations
 
 import logging
-import os
-import re
 import threading
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
+from .. import cliutil
 from ..errors import Rend3rError
 
 if TYPE_CHECKING:
@@ -22,12 +21,17 @@ if TYPE_CHECKING:
 log = logging.getLogger("rend3r.device")
 
 
+#: The virtual device renders frames of at most this many pixels per side: a frame is rendered
+#: for each program a sender pushes, so the cap bounds the work one received program causes.
+MAX_DEVICE_SIDE = 4096
+
+
 def parse_size(text: str) -> tuple[int, int]:
-    """``WxH`` to (width, height); Rend3rError if malformed."""
-    m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
-    if not m or not (0 < int(m[1]) <= 4096 and 0 < int(m[2]) <= 4096):
-        raise Rend3rError(f"malformed size {text!r}: expected WxH like 128x96 (1..4096 each)")
-    return int(m[1]), int(m[2])
+    """``WxH`` to (width, height), each 1..MAX_DEVICE_SIDE; Rend3rError if malformed."""
+    try:
+        return cliutil.parse_size(text, max_side=MAX_DEVICE_SIDE)
+    except ValueError as exc:
+        raise Rend3rError(f"malformed size: {exc}") from None
 
 
 class _Superseded(Exception):
@@ -92,10 +96,7 @@ class RenderExecutor:
             delay = self._next_frame_at - time.monotonic()
             if cancel.wait(max(0.0, delay)):
                 raise _Superseded
-            name = f"run{run:04d}_frame{frame.number:04d}.png"
-            tmp = self.out / f".{name}.tmp"  # renamed when complete: readers never see half a PNG
-            save_png(frame.rgb565, tmp)
-            os.replace(tmp, self.out / name)
+            save_png(frame.rgb565, self.out / f"run{run:04d}_frame{frame.number:04d}.png")  # atomic
             self._next_frame_at = time.monotonic() + self.interval
             self.frames += 1
 

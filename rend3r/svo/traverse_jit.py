@@ -4,12 +4,13 @@ The same state machine, integer arithmetic, short-stack and restart semantics as
 lockstep numpy traversal in :mod:`rend3r.svo.traverse`, step for step, so every output
 (hit, t, entered axis, voxel, counters, memory-request trace) is bit-identical; the tests
 check that. Importing this module imports numba: :func:`rend3r.svo.traverse.trace` loads
-it only when the numba kernel is selected. Ray setup (normalisation, clamping, dir-mask,
-root t-values) stays in numpy and is shared with the numpy path.
+it only when the numba kernel is selected. The ray setup (normalisation, clamping,
+dir-mask, root t-values rounded to 16.16) runs in the kernel too, repeating
+:func:`rend3r.svo.traverse.setup_rays` operation for operation.
 
 The kernel is compiled on first use (several seconds). Numba caches the machine code on
 disk (``__pycache__`` next to this file, or numba's per-user cache directory when that is
-not writable) so later processes load it in well under a second; set
+not writable) so later processes load it in about a second; set
 ``REND3R_JIT_CACHE=0`` to compile in memory only (the tests do).
 """
 

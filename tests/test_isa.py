@@ -74,3 +74,31 @@ def test_shortest_repr_round_trips(bits):
     else:
         neg = text.startswith("-")
         assert round_literal(text.lstrip("-"), negative=neg).bits == bits
+
+
+def test_shortest_repr_matches_numpy_dragon4_for_every_float16():
+    for bits in range(0x10000):
+        if (bits & 0x7C00) == 0x7C00:
+            continue
+        h = np.array(bits, dtype=np.uint16).view(np.float16)[()]
+        text = np.format_float_positional(h, unique=True, trim="0")
+        sci = np.format_float_scientific(h, unique=True, trim="0")
+        expected = sci.replace("e+", "e") if len(sci) < len(text) else text
+        assert shortest_repr(bits) == expected, hex(bits)
+
+
+def test_float_to_bits_saturates_to_infinity():
+    from rend3r.isa.float16 import float_to_bits
+
+    assert float_to_bits(65519.0) == 0x7BFF
+    assert float_to_bits(65520.0) == 0x7C00
+    assert float_to_bits(-1e9) == 0xFC00
+
+
+def test_assembler_does_not_import_numpy():
+    import subprocess
+    import sys
+
+    code = "import sys, rend3r.cli, rend3r.asm.assembler, rend3r.asm.cli_asm; print('numpy' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "False"

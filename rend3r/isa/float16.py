@@ -6,11 +6,11 @@ their decimal value, not through a float64 first, so no double rounding can occu
 
 from __future__ import annotations
 
+import functools
 import math
+import struct
 from dataclasses import dataclass
 from fractions import Fraction
-
-import numpy as np
 
 MAX_FINITE = 65504.0
 MIN_NORMAL = 2.0**-14
@@ -34,7 +34,7 @@ class Rounded:
 
 def bits_to_float(bits: int) -> float:
     """The value of a float16 bit pattern (NaN and infinities included)."""
-    return float(np.array(bits & 0xFFFF, dtype=np.uint16).view(np.float16))
+    return struct.unpack("<e", struct.pack("<H", bits & 0xFFFF))[0]
 
 
 def float_to_bits(value: float) -> int:
@@ -43,8 +43,10 @@ def float_to_bits(value: float) -> int:
     Rounding a float64 is exact except when the float64 itself came from rounding a
     decimal; use :func:`round_literal` for source literals.
     """
-    with np.errstate(over="ignore"):
-        return int(np.array(value, dtype=np.float16).view(np.uint16))
+    try:
+        return struct.unpack("<H", struct.pack("<e", value))[0]
+    except OverflowError:  # |value| >= 65520 rounds to infinity
+        return 0xFC00 if value < 0 else 0x7C00
 
 
 def round_literal(text: str | Fraction | int | float, negative: bool = False) -> Rounded:
@@ -117,13 +119,59 @@ def is_subnormal(bits: int) -> bool:
     return (bits & 0x7C00) == 0 and (bits & 0x03FF) != 0
 
 
+@functools.lru_cache(maxsize=None)  # 65,536 possible arguments
 def shortest_repr(bits: int) -> str | None:
-    """Shortest decimal that rounds back to ``bits``; None for NaN and infinities."""
+    """Shortest decimal that rounds back to ``bits``; None for NaN and infinities.
+
+    Positional (``0.25``, ``65504.0``) unless scientific (``5.96e-08``) is shorter.
+    """
     if is_nan(bits) or is_inf(bits):
         return None
-    h = np.array(bits & 0xFFFF, dtype=np.uint16).view(np.float16)[()]
-    text = np.format_float_positional(h, unique=True, trim="0")
-    sci = np.format_float_scientific(h, unique=True, trim="0")
-    if len(sci) < len(text):
-        text = sci.replace("e+", "e")
-    return text
+    value = bits_to_float(bits)
+    sign = "-" if bits & 0x8000 else ""
+    if value == 0:
+        return sign + "0.0"
+    for places in range(5):  # float16 needs at most 5 significant digits
+        found = _round_tripping(abs(value), places, bits & 0x7FFF)
+        if found:
+            mantissa, exp = found
+            break
+    digits, e10 = mantissa.replace(".", "").rstrip("0") or "0", int(exp)
+    if e10 >= 0:
+        whole = digits[: e10 + 1].ljust(e10 + 1, "0")
+        positional = f"{whole}.{digits[e10 + 1:] or '0'}"
+    else:
+        positional = f"0.{'0' * (-e10 - 1)}{digits}"
+    scientific = f"{digits[0]}.{digits[1:] or '0'}e{'-' if e10 < 0 else '+'}{abs(e10):02d}"
+    if len(scientific) < len(positional):
+        return sign + scientific.replace("e+", "e")
+    return sign + positional
+
+
+def _round_tripping(value: float, places: int, bits: int) -> tuple[str, str] | None:
+    """The (mantissa, exponent) with ``places`` decimals nearest ``value`` that rounds to
+    ``bits``: the correctly rounded one (Python's formatting rounds exactly, ties to even),
+    else the nearer round-tripping neighbour (the float16 rounding interval is lopsided at
+    powers of two)."""
+    mantissa, exp = f"{value:.{places}e}".split("e")
+    if _rounds_to(mantissa, exp, bits):
+        return mantissa, exp
+    n = int(mantissa.replace(".", ""))
+    fits = [c for c in (n - 1, n + 1) if 10**places <= c < 10 ** (places + 1)]
+    texts = [t for t in (_digits(c, places) for c in fits) if _rounds_to(t, exp, bits)]
+    if not texts:
+        return None
+    exact = Fraction(value)
+    return min(texts, key=lambda t: abs(Fraction(f"{t}e{exp}") - exact)), exp
+
+
+def _digits(n: int, places: int) -> str:
+    text = str(n)
+    return text[0] + ("." + text[1:] if places else "")
+
+
+def _rounds_to(mantissa: str, exp: str, bits: int) -> bool:
+    approx = float(f"{mantissa}e{exp}")
+    if _may_be_tie(approx):
+        return round_literal(f"{mantissa}e{exp}").bits == bits
+    return float_to_bits(approx) == bits

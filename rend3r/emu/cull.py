@@ -17,7 +17,7 @@ from typing import Iterator
 
 import numpy as np
 
-from .shapes import Shapes
+from .shapes import SPHERE, Shapes
 
 TILE = 16  # pixels per tile side
 PAIR_CHUNK = 1 << 16  # pixel-shape pairs per batch: temporaries stay cache-sized
@@ -69,7 +69,7 @@ def shape_bounds(shapes: Shapes) -> Bounds:
     center = np.stack([np.asarray(c, np.float64) for c in shapes.loc], axis=1)
     smin, smax = q2 * s.min(axis=1), q2 * s.max(axis=1)
     with np.errstate(all="ignore"):
-        ok = (shapes.kind == 1) & np.isfinite(center).all(axis=1) & (smin >= 2.0**-6) & (smax <= 2.0**6)
+        ok = (shapes.kind == SPHERE) & np.isfinite(center).all(axis=1) & (smin >= 2.0**-6) & (smax <= 2.0**6)
     return Bounds(center, smin, smax, ok)
 
 

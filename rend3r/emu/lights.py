@@ -6,12 +6,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..isa import Table
+from ..isa import Table, lookup
+from ..isa.tables import LIGHT_SOURCE_CODES
 from .arith import Arith
 from .scene import Scene, prop_index
 from .vec import Vec
 
-DIRECTIONAL, POINT = 1, 2
+DIRECTIONAL, POINT = LIGHT_SOURCE_CODES["directional"], LIGHT_SOURCE_CODES["point"]
+_SRC_MASK = lookup(Table.LIGHT, "src").value_mask
 WHITE = 0xFFFF
 #: Unset (never written since the last nr) colour and intensity: white at full strength.
 DEFAULT_INTENSITY = 1.0
@@ -38,7 +40,7 @@ def lights_from_scene(scene: Scene, arith: Arith, model: str = "spec") -> list[L
     out = []
     for index in sorted(scene.lights) if model == "spec" else [0]:
         props = scene.lights.get(index, {})
-        kind = props.get(p["src"], 0) & 3 if model == "spec" else DIRECTIONAL
+        kind = props.get(p["src"], 0) & _SRC_MASK if model == "spec" else DIRECTIONAL
         if kind not in (DIRECTIONAL, POINT):
             continue
         if model != "spec":

@@ -67,7 +67,9 @@ def execute(
         if isinstance(ins, Unknown):
             selected = decode_table_select(ins.word) if options.mode == "hybrid" else None
             if selected is None:
-                raise Rend3rError(f"{here}: unknown opcode 0b{OPCODE.get(ins.word):03b} in word 0x{ins.word:08x}")
+                hint = ("; it is a TS table-select word (docs/isa-extensions.md): run with --mode hybrid"
+                        if decode_table_select(ins.word) is not None else "")
+                raise Rend3rError(f"{here}: unknown opcode 0b{OPCODE.get(ins.word):03b} in word 0x{ins.word:08x}{hint}")
             table = selected
             pc += size
             continue

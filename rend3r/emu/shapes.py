@@ -12,13 +12,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..isa import Table
+from ..isa import Table, lookup
+from ..isa.float16 import float_to_bits
+from ..isa.tables import SHAPE_TYPE_CODES
 from .arith import Arith
 from .scene import Scene, prop_index
 from .vec import Quat, Vec, dot, madd3, mul3, rotate, rotate_inverse, sub3
 
 #: z-term sign and constant of each shape type's normal form: x^2 + y^2 + zsign*z^2 = one.
-NORMAL_FORMS = {1: (1.0, 1.0), 2: (0.0, 1.0), 3: (-1.0, 0.0)}  # sphere, cylinder, cone
+NORMAL_FORMS = {SHAPE_TYPE_CODES[name]: form for name, form in (
+    ("sphere", (1.0, 1.0)), ("cylinder", (0.0, 1.0)), ("cone", (-1.0, 0.0)))}
+SPHERE = SHAPE_TYPE_CODES["sphere"]
+_TYPE = lookup(Table.SHAPE, "type")
+_ONE = float_to_bits(1.0)
 
 
 @dataclass(frozen=True)
@@ -26,7 +32,7 @@ class Shapes:
     """The shapes that are on, in index order (one entry per shape, or per pair after take)."""
 
     index: np.ndarray  # program shape index (int64)
-    kind: np.ndarray  # 1 sphere, 2 cylinder, 3 cone
+    kind: np.ndarray  # shape type code (SHAPE_TYPES)
     loc: Vec
     rot: Quat
     inv_scale: Vec
@@ -50,17 +56,17 @@ def shapes_from_scene(scene: Scene, arith: Arith) -> Shapes:
     """Collect the shapes whose type is sphere, cylinder or cone (others are off)."""
     p = {n: prop_index(Table.SHAPE, n) for n in (
         "xloc", "yloc", "zloc", "rrot", "irot", "jrot", "krot", "xscl", "yscl", "zscl", "col", "type")}
-    rows = sorted((i, props) for i, props in scene.objects.items() if props.get(p["type"], 0) & 0xF in NORMAL_FORMS)
+    rows = sorted((i, props) for i, props in scene.objects.items() if props.get(p["type"], 0) & _TYPE.value_mask in NORMAL_FORMS)
     n = len(rows)
 
     def bits(name: str) -> np.ndarray:
         return np.fromiter((props.get(p[name], 0) for _, props in rows), dtype=np.uint16, count=n)
 
-    kind = bits("type") & 0xF
+    kind = bits("type") & _TYPE.value_mask
     rot = [bits(n) for n in ("rrot", "irot", "jrot", "krot")]
     unset = (rot[0] | rot[1] | rot[2] | rot[3]) & 0x7FFF == 0  # all-zero quaternion: identity
-    rot[0] = np.where(unset, np.uint16(0x3C00), rot[0])
-    forms = np.array([NORMAL_FORMS.get(int(k), (0.0, 0.0)) for k in range(16)])
+    rot[0] = np.where(unset, np.uint16(_ONE), rot[0])
+    forms = np.array([NORMAL_FORMS.get(int(k), (0.0, 0.0)) for k in range(_TYPE.value_mask + 1)])
     return Shapes(
         index=np.fromiter((i for i, _ in rows), dtype=np.int64, count=n),
         kind=kind.astype(np.uint8),

@@ -107,6 +107,11 @@ class Property:
         return (self.name, self.register, *self.extra_names)
 
     @property
+    def value_mask(self) -> int:
+        """The bits of the 16-bit field the device reads (INT: its low ``bits``)."""
+        return (1 << self.bits) - 1
+
+    @property
     def type_label(self) -> str:
         if self.vtype is ValueType.INT:
             return f"int{self.bits}"
@@ -199,6 +204,8 @@ F_MNEMONICS: dict[str, Func] = {"er": Func.ER, "nr": Func.NR, "nf": Func.NF, "lr
 #: Light source types (low 2 bits of ``src``) and shape types (``type``).
 LIGHT_SOURCES = {0: "off", 1: "directional", 2: "point"}
 SHAPE_TYPES = {0: "off", 1: "sphere", 2: "cylinder", 3: "cone"}
+LIGHT_SOURCE_CODES = {name: code for code, name in LIGHT_SOURCES.items()}
+SHAPE_TYPE_CODES = {name: code for code, name in SHAPE_TYPES.items()}
 
 
 def by_index(table: Table) -> dict[int, Property]:

@@ -68,3 +68,8 @@ def test_hybrid_without_select_words_equals_raytrace_mode():
     a = run_program(words, EmuOptions(mode="hybrid", width=W, height=H)).frames[0]
     b = run_program(words, EmuOptions(width=W, height=H)).frames[0]
     assert np.array_equal(a.rgb565, b.rgb565) and np.array_equal(a.provenance, b.provenance)
+
+
+def test_ts_word_outside_hybrid_mode_names_the_fix():
+    with pytest.raises(Rend3rError, match="--mode hybrid"):
+        run_program([table_select_word(Table.TRIANGLE), 0, 0], options=EmuOptions(mode="raytrace"))

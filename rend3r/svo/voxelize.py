@@ -111,8 +111,7 @@ def _batches(weights: np.ndarray, limit: int):
 
 def _keys(coords: np.ndarray, n: int) -> np.ndarray:
     """Sorted unique linear keys ``(x*n + y)*n + z`` of voxel coordinates."""
-    key = np.sort((coords[:, 0] * n + coords[:, 1]) * n + coords[:, 2])
-    return key[np.r_[True, key[1:] != key[:-1]]]
+    return np.unique((coords[:, 0] * n + coords[:, 1]) * n + coords[:, 2])
 
 
 def _rows(keys: np.ndarray, n: int) -> np.ndarray:
@@ -135,7 +134,7 @@ def _split_large(tri: np.ndarray, n: int) -> np.ndarray:
     The pieces cover the same points, so the overlapped voxels do not change; only the
     memory of one batch stays bounded.
     """
-    done = []
+    done = [tri[:0]]
     while len(tri):
         big = _weight(tri, n) > _CHUNK
         done.append(tri[~big])
@@ -146,13 +145,17 @@ def _split_large(tri: np.ndarray, n: int) -> np.ndarray:
 
 
 def voxelize_surface(tri_grid: np.ndarray, n: int) -> np.ndarray:
-    """Unique voxels (M, 3) overlapped by triangles given in grid units (voxel i = [i, i+1])."""
+    """Unique voxels (M, 3) overlapped by triangles given in grid units (voxel i = [i, i+1]).
+
+    Degenerate triangles (equal or collinear vertices: zero area) cover no surface and
+    are skipped; M is 0 when every triangle is degenerate.
+    """
+    tri_grid = tri_grid[np.any(np.cross(tri_grid[:, 1] - tri_grid[:, 0], tri_grid[:, 2] - tri_grid[:, 0]), axis=1)]
     tri_grid = _split_large(tri_grid, n)
     weight = _weight(tri_grid, n)
     # batches keep only their unique keys (8 bytes a voxel) until the final merge
-    keys = np.concatenate([_keys(_surface_chunk(tri_grid[s], n), n) for s in _batches(weight, _CHUNK)])
-    keys = np.sort(keys)
-    return _rows(keys[np.r_[True, keys[1:] != keys[:-1]]], n)
+    keys = [_keys(_surface_chunk(tri_grid[s], n), n) for s in _batches(weight, _CHUNK)]
+    return _rows(np.unique(np.concatenate(keys)) if keys else np.empty(0, np.int64), n)
 
 
 def fill_solid(tri_grid: np.ndarray, n: int) -> np.ndarray:
@@ -171,6 +174,8 @@ def fill_solid(tri_grid: np.ndarray, n: int) -> np.ndarray:
     w0, w1, w2 = edge(b, c), edge(c, a), edge(a, b)
     area = w0 + w1 + w2
     inside = (area != 0) & (((w0 > 0) & (w1 > 0) & (w2 > 0)) | ((w0 < 0) & (w1 < 0) & (w2 < 0)))
+    if not inside.any():  # no triangle covers a column centre seen from +z
+        return np.empty((0, 3), dtype=np.int64)
     z = (w0 * a[:, 2] + w1 * b[:, 2] + w2 * c[:, 2])[inside] / area[inside]
     sign = np.where(area[inside] > 0, -1, 1)  # counter-clockwise seen from +z faces up: an exit
     col = (ix * n + iy)[inside]
@@ -200,6 +205,8 @@ def voxelize(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool = Fal
     n = 1 << depth
     tri = (np.asarray(verts, dtype=np.float64)[faces] - lo) / h
     coords = voxelize_surface(tri, n)
+    if len(coords) == 0:
+        raise Rend3rError("mesh has no area: every triangle has equal or collinear vertices")
     if solid:
         coords = _unique_rows(np.concatenate([coords, fill_solid(tri, n)]), n)
     return coords, lo, h

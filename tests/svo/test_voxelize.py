@@ -117,3 +117,38 @@ def test_large_triangles_are_split_without_changing_the_result(monkeypatch):
     monkeypatch.setattr(vox, "_CHUNK", 64)  # forces every triangle to be split many times
     split, _, _ = voxelize(v, f, 6)
     assert _as_set(split) == _as_set(coords)
+
+
+@pytest.mark.parametrize("solid", [False, True])
+@pytest.mark.parametrize("verts", [[[1, 2, 3]] * 3, [[0, 0, 0], [1, 1, 1], [3, 3, 3]]], ids=["equal", "collinear"])
+def test_degenerate_mesh_has_no_area(verts, solid):
+    with pytest.raises(Rend3rError, match="has no area"):
+        voxelize(np.array(verts, float), np.array([[0, 1, 2]]), 3, solid=solid)
+
+
+def test_degenerate_triangles_are_skipped_beside_real_ones():
+    v = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0.5, 0.5, 0.5]])  # all vertices set the bounds
+    good, _, _ = voxelize(v, np.array([[0, 1, 2]]), 4)
+    mixed, _, _ = voxelize(v, np.array([[0, 1, 2], [3, 3, 3], [0, 3, 3], [0, 1, 1]]), 4)
+    assert len(good) and _as_set(mixed) == _as_set(good)
+
+
+def test_edge_on_triangle_fills_no_column():
+    """Seen from +z this wall has no area: the solid fill adds nothing, without warnings."""
+    wall = np.array([[0.0, 0, 0], [1, 0, 0], [0, 0, 1]])
+    with np.errstate(all="raise"):
+        solid, _, _ = voxelize(wall, np.array([[0, 1, 2]]), 3, solid=True)
+    surface, _, _ = voxelize(wall, np.array([[0, 1, 2]]), 3)
+    assert len(surface) and _as_set(solid) == _as_set(surface)
+
+
+def test_svo_build_of_a_degenerate_obj_is_a_clean_error(tmp_path):
+    from click.testing import CliRunner
+
+    from rend3r.cli import main
+
+    obj = tmp_path / "flat.obj"
+    obj.write_text("v 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n")
+    r = CliRunner().invoke(main, ["svo", "build", str(obj), "-o", str(tmp_path / "x.svo"), "--depth", "3"])
+    assert r.exit_code == 1 and "has no area" in r.output, r.output
+    assert not (tmp_path / "x.svo").exists()

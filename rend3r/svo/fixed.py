@@ -26,11 +26,6 @@ def to_fixed(x: np.ndarray | float) -> np.ndarray:
     return scaled.astype(np.int32)
 
 
-def to_float(x: np.ndarray | int) -> np.ndarray:
-    """16.16 values as float64."""
-    return np.asarray(x, dtype=np.float64) / ONE
-
-
 def half(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Arithmetic shift right by one: (x >> 1, the discarded low bit) as in the hardware."""
     return x >> 1, x & 1

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..emu.image import rgb565_to_rgb888 as rgb565_to_888  # noqa: F401 (svo cli's name)
 from ..errors import Rend3rError
 from .camera import Camera
 
@@ -20,13 +21,6 @@ def rgb888_to_565(rgb: np.ndarray) -> np.ndarray:
     """(h, w, 3) uint8 -> (h, w) uint16 RGB565 (truncating, as the frame buffer does)."""
     rgb = np.asarray(rgb, dtype=np.uint16)
     return ((rgb[..., 0] >> 3) << 11) | ((rgb[..., 1] >> 2) << 5) | (rgb[..., 2] >> 3)
-
-
-def rgb565_to_888(c: np.ndarray) -> np.ndarray:
-    """(h, w) uint16 RGB565 -> (h, w, 3) uint8, replicating high bits into the low ones."""
-    c = np.asarray(c, dtype=np.uint16)
-    r, g, b = (c >> 11) & 31, (c >> 5) & 63, c & 31
-    return np.stack([(r << 3) | (r >> 2), (g << 2) | (g >> 4), (b << 3) | (b >> 2)], -1).astype(np.uint8)
 
 
 def _pixel_dirs(cam: Camera) -> np.ndarray:

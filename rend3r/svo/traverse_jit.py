@@ -10,7 +10,7 @@ dir-mask, root t-values rounded to 16.16) runs in the kernel too, repeating
 
 The kernel is compiled on first use (several seconds). Numba caches the machine code on
 disk (``__pycache__`` next to this file, or numba's per-user cache directory when that is
-not writable) so later processes load it in about a second; set
+not writable) so later processes load it in a second or two; set
 ``REND3R_JIT_CACHE=0`` to compile in memory only (the tests do).
 """
 

@@ -31,7 +31,7 @@ def load_image(path: Path, size: tuple[int, int] | None = None) -> np.ndarray:
         try:
             with Image.open(path) as im:
                 return np.asarray(im.convert("RGB"), dtype=np.uint8)
-        except (OSError, UnidentifiedImageError) as exc:
+        except (OSError, ValueError, SyntaxError, UnidentifiedImageError, Image.DecompressionBombError) as exc:
             raise Rend3rError(f"cannot read PNG {path}: {exc}") from None
     w, h = size if size is not None else DEVICE_SIZE
     if len(data) != 2 * w * h:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 from click.testing import CliRunner
 from PIL import Image
 
@@ -100,3 +101,14 @@ def test_diff_path_is_checked_before_comparing(tmp_path: Path) -> None:
         r = CliRunner().invoke(main, ["compare", str(a), str(a), "--diff", str(diff)])
         assert r.exit_code == 2 and why in r.output, r.output
         assert not diff.exists()
+
+
+@pytest.mark.parametrize(("pos", "value"), [(11, 0), (36, 0), (20, 0xFF)])
+def test_damaged_pngs_are_errors_not_tracebacks(tmp_path: Path, pos: int, value: int) -> None:
+    """Pillow reports damage as OSError, ValueError (a short IHDR) or SyntaxError (a broken chunk)."""
+    data = bytearray(_png(tmp_path / "good.png", np.zeros((4, 4, 3), np.uint8)).read_bytes())
+    data[pos] = value
+    bad = tmp_path / "bad.png"
+    bad.write_bytes(bytes(data))
+    r = CliRunner().invoke(main, ["compare", str(bad), str(tmp_path / "good.png")])
+    assert r.exit_code == 2 and "cannot read PNG" in r.output, (r.output, repr(r.exception))

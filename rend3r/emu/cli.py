@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import os
 import sys
 
 import click
@@ -78,6 +79,8 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
                         (gif_path, ANIMATION_KINDS["gif"]), (apng_path, ANIMATION_KINDS["apng"])):
         if path:
             check_output(path, kinds, make_parents=is_pattern(path))
+    if trace_path and not os.path.isdir(os.path.dirname(trace_path) or "."):
+        raise Rend3rError(f"{trace_path}: folder {os.path.dirname(trace_path)} does not exist")
     loaded = load_program(program)
     options = EmuOptions(precision=precision, subnormals=subnormals, mode=mode or loaded.mode_hint or "raytrace",
                          width=size[0], height=size[1], background=background, depth=visibility)

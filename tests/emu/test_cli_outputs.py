@@ -68,3 +68,10 @@ def test_frames_zero_and_huge_sizes_are_usage_errors(tmp_path):
     for size in ("100000x100000", "0x5", "axb"):
         r = _run(src, "-o", tmp_path / "f.png", "--size", size)
         assert r.exit_code == 2 and "--size" in r.output, (size, r.output)
+
+
+def test_trace_file_in_a_missing_folder_is_refused_before_rendering(tmp_path):
+    r = _run(_src(tmp_path), "-o", tmp_path / "f.png", "--size", "8x6", "--trace-pixel", "1,1",
+             "--trace", tmp_path / "nope" / "t.jsonl")
+    assert r.exit_code == 1 and "does not exist" in r.output
+    assert not (tmp_path / "f.png").exists()

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from ..cliutil import SIZE
 from ..errors import Rend3rError
 
 _EPILOG = """\b
@@ -18,16 +19,6 @@ Examples:
   rend3r svo render folded.svo -o hybrid.png --with-program programs/sphere.asm --place 0.8,0.3,-3.5,0.8
   rend3r svo sweep folded.svo -o sweep
 """
-
-
-def _size(ctx, param, value: str) -> tuple[int, int]:
-    try:
-        w, h = (int(x) for x in value.lower().split("x"))
-    except ValueError:
-        raise click.BadParameter("expected WIDTHxHEIGHT, e.g. 640x480") from None
-    if not (0 < w <= 8192 and 0 < h <= 8192):
-        raise click.BadParameter("width and height must be 1..8192")
-    return w, h
 
 
 @click.group("svo", epilog=_EPILOG)
@@ -122,7 +113,7 @@ def _place(value: str | None):
 @svo_group.command("render")
 @click.argument("model", type=click.Path(dir_okay=False))
 @click.option("-o", "--output", required=True, help="PNG image to write.")
-@click.option("--size", default="640x480", show_default=True, callback=_size, help="WIDTHxHEIGHT.")
+@click.option("--size", type=SIZE, default="640x480", show_default=True, help="WIDTHxHEIGHT (1..8192 each).")
 @click.option("--mode", type=click.Choice(["shaded", "depth"]), default="shaded", show_default=True)
 @click.option("--stack", type=click.IntRange(0, 64), default=8, show_default=True,
               help="Short-stack depth (0 = restart only).")
@@ -145,21 +136,26 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
     """Trace MODEL.svo and write an image (depth or shaded)."""
     from PIL import Image
 
+    from ..emu.image import check_output, write_image
     from .camera import model_matrix, orbit_camera
     from .fileformat import read_svo
     from .render import cost_image, render
 
+    for path in (output, cost_path):
+        if path:
+            check_output(path, (".png",))
     kernel = _kernel(kernel, not use_float)
     svo = read_svo(model)
     if program is not None:
-        from .hybrid import program_hybrid, rgb565_to_888
+        from ..emu.image import rgb565_to_rgb888
+        from .hybrid import program_hybrid
 
         bounds = _place(place) or svo.bounds
         frames = program_hybrid(svo, program, model_matrix(bounds), size[0], size[1], stack,
                                 kernel=kernel)
         if not frames:
             raise Rend3rError(f"{program}: the program renders no frame")
-        Image.fromarray(rgb565_to_888(frames[0][0])).save(output)
+        write_image(output, Image.fromarray(rgb565_to_rgb888(frames[0][0])))
         click.echo(f"{output}: hybrid frame, {size[0]}x{size[1]}")
         return
     if place is not None:
@@ -168,9 +164,9 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
     start = time.perf_counter()
     r = render(svo, cam, stack, not use_float, mode, kernel=kernel)
     elapsed = time.perf_counter() - start
-    Image.fromarray(r.rgb).save(output)
+    write_image(output, Image.fromarray(r.rgb))
     if cost_path:
-        Image.fromarray(cost_image(r.cost)).save(cost_path)
+        write_image(cost_path, Image.fromarray(cost_image(r.cost)))
     stats = r.result.stats()
     stats["seconds"] = round(elapsed, 3)
     stats["rays_per_s"] = round(stats["rays"] / max(elapsed, 1e-9))
@@ -184,7 +180,7 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
 @svo_group.command("sweep")
 @click.argument("model", type=click.Path(dir_okay=False))
 @click.option("-o", "--output", required=True, help="Output prefix: writes PREFIX.csv and PREFIX.md.")
-@click.option("--size", default="320x240", show_default=True, callback=_size, help="WIDTHxHEIGHT.")
+@click.option("--size", type=SIZE, default="320x240", show_default=True, help="WIDTHxHEIGHT (1..8192 each).")
 @click.option("--views", type=click.IntRange(1, 16), default=1, show_default=True,
               help="Camera azimuths averaged (the thesis used four for Table 7.1).")
 @click.option("--jobs", type=click.IntRange(1, 64), default=2, show_default=True, help="Worker processes.")

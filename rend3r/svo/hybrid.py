@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..emu.image import rgb565_to_rgb888 as rgb565_to_888  # noqa: F401 (svo cli's name)
 from ..errors import Rend3rError
 from .camera import Camera
 

@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
 
+from rend3r.emu.image import rgb565_to_rgb888
 from rend3r.svo.camera import Camera, orbit_camera
 from rend3r.svo.fileformat import SvoModel
-from rend3r.svo.hybrid import (distance_to_ndc_z, merge, ndc_z_to_distance, program_hybrid,
-                               rgb565_to_888, rgb888_to_565)
+from rend3r.svo.hybrid import distance_to_ndc_z, merge, ndc_z_to_distance, program_hybrid, rgb888_to_565
 from rend3r.svo.octree import build_octree
 from rend3r.svo.render import render
 
@@ -46,7 +46,7 @@ def test_depth_conversion_is_monotonic():
 
 def test_rgb565_conversions():
     c = np.arange(0, 65536, 97, dtype=np.uint16).reshape(1, -1)
-    assert np.array_equal(rgb888_to_565(rgb565_to_888(c)), c)
+    assert np.array_equal(rgb888_to_565(rgb565_to_rgb888(c)), c)
 
 
 def test_program_hybrid_occludes_both_ways():

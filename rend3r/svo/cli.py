@@ -75,7 +75,10 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
         if depth is None:
             raise Rend3rError("--depth is required for mesh input")
         verts, faces = read_mesh(mesh)
-        coords, lo, h = voxelize(verts, faces, depth, solid)
+        try:
+            coords, lo, h = voxelize(verts, faces, depth, solid)
+        except Rend3rError as exc:
+            raise Rend3rError(f"{mesh}: {exc}") from None
     tree = build_octree(coords, depth, ptr_bits)
     hi = lo + h * (1 << depth)
     write_svo(output, SvoModel(tree, tuple(float(x) for x in lo) + tuple(float(x) for x in hi), len(coords)))

@@ -150,5 +150,5 @@ def test_svo_build_of_a_degenerate_obj_is_a_clean_error(tmp_path):
     obj = tmp_path / "flat.obj"
     obj.write_text("v 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n")
     r = CliRunner().invoke(main, ["svo", "build", str(obj), "-o", str(tmp_path / "x.svo"), "--depth", "3"])
-    assert r.exit_code == 1 and "has no area" in r.output, r.output
+    assert r.exit_code == 1 and f"{obj}: mesh has no area" in r.output, r.output
     assert not (tmp_path / "x.svo").exists()

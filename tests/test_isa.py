@@ -95,10 +95,10 @@ def test_float_to_bits_saturates_to_infinity():
     assert float_to_bits(-1e9) == 0xFC00
 
 
-def test_assembler_does_not_import_numpy():
+def test_assembler_and_disassembler_do_not_import_numpy():
     import subprocess
     import sys
 
-    code = "import sys, rend3r.cli, rend3r.asm.assembler, rend3r.asm.cli_asm; print('numpy' in sys.modules)"
+    code = "import sys, rend3r.cli, rend3r.asm.assembler, rend3r.asm.cli_asm, rend3r.asm.disasm, rend3r.asm.cli_disasm; print('numpy' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "False"

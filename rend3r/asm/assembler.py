@@ -20,7 +20,7 @@ from typing import Iterable, Mapping
 
 from ..errors import Rend3rError
 from ..isa.encoding import CameraSet, FrameOp, LightSet, ShapeSet, encode
-from ..isa.extensions import table_select_word
+from ..isa.extensions import EXTENSIONS, table_select_word
 from ..isa.float16 import Rounded, round_literal, shortest_repr
 from ..isa.tables import (
     F_MNEMONICS,
@@ -58,7 +58,7 @@ WORD_LIMIT = 1 << 32
 MNEMONICS = (*F_MNEMONICS, *MNEMONIC_TABLE)
 DIRECTIVES = (".include", ".rept", ".endr", ".word", ".isa_ext")
 #: ISA extensions a program may opt into (docs/isa-extensions.md) -> the mnemonics each adds
-ISA_EXTENSIONS: Mapping[str, tuple[str, ...]] = {"hybrid": ("ts",)}
+ISA_EXTENSIONS: Mapping[str, tuple[str, ...]] = EXTENSIONS
 #: what ``isa_ext=`` accepts: one extension name, several, or None
 IsaExt = str | Iterable[str] | None
 _EXTENSION_OF = {m: name for name, ms in ISA_EXTENSIONS.items() for m in ms}

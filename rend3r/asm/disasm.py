@@ -12,10 +12,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import lru_cache
 
-import numpy as np
-
 from ..isa.encoding import is_canonical
-from ..isa.extensions import TS_OPCODE, TS_TABLE, decode_table_select
+from ..isa.extensions import EXTENSIONS, TS_OPCODE, TS_TABLE, decode_table_select
 from ..isa.float16 import bits_to_float, is_subnormal, round_literal, shortest_repr
 from ..isa.tables import (
     DATA,
@@ -42,7 +40,7 @@ from .program import Emitted, Program
 #: mode -> (shape mnemonic, the table its property operands name)
 MODES: dict[str, tuple[str, Table]] = {"raytrace": ("sp", Table.SHAPE), "raster": ("tr", Table.TRIANGLE)}
 #: ISA extensions the disassembler prints (named as the assembler's ``.isa_ext`` names them)
-ISA_EXTENSIONS = ("hybrid",)
+ISA_EXTENSIONS = tuple(EXTENSIONS)
 _PAIR_MNEMONIC = {table: mnemonic for mnemonic, table in MODES.values()}
 
 _F_NAMES = {func: name for name, func in F_MNEMONICS.items()}
@@ -93,7 +91,9 @@ def float_operand(bits: int) -> str:
     digits = 1
     while _loss(text) > LOSS_WARNING:
         digits += 1
-        text = np.format_float_scientific(bits_to_float(bits), precision=digits, unique=False, trim="0").replace("e+", "e")
+        mantissa, exp = f"{bits_to_float(bits):.{digits}e}".split("e")
+        mantissa = mantissa.rstrip("0")
+        text = f"{mantissa}{'0' if mantissa.endswith('.') else ''}e{exp}"
     return text
 
 

@@ -10,6 +10,9 @@ from __future__ import annotations
 
 from .tables import Field, Table
 
+#: Extension name -> the mnemonics it adds (what ``--isa-ext`` / ``.isa_ext`` enable).
+EXTENSIONS: dict[str, tuple[str, ...]] = {"hybrid": ("ts",)}
+
 TS_OPCODE = 0b010
 TS_TABLE = Field(4, 3)
 #: Table codes of TS; 0b11 is reserved.

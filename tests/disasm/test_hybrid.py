@@ -10,7 +10,7 @@ from click.testing import CliRunner
 from hypothesis import given, settings, strategies as st
 
 from rend3r.asm import assembler
-from rend3r.asm.disasm import ISA_EXTENSIONS, disassemble, disassemble_lines, disassemble_program
+from rend3r.asm.disasm import disassemble, disassemble_lines, disassemble_program
 from rend3r.asm.formats import render
 from rend3r.cli import main
 from rend3r.isa import ShapeSet, encode
@@ -79,10 +79,6 @@ def test_bad_arguments_are_programming_errors():
         disassemble(WORDS, isa_ext="vector")
     with pytest.raises(ValueError, match="raster mode does not apply with the hybrid extension"):
         disassemble(WORDS, "raster", isa_ext="hybrid")
-
-
-def test_the_names_are_the_assemblers():
-    assert set(ISA_EXTENSIONS) == set(assembler.ISA_EXTENSIONS)
 
 
 # -- round trips -----------------------------------------------------------------------

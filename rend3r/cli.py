@@ -45,7 +45,7 @@ class LazyGroup(click.Group):
         try:
             return super().invoke(ctx)
         except Rend3rError as exc:
-            click.echo(f"rend3r: error: {exc}", err=True)
+            click.echo(str(exc) if exc.preformatted else f"rend3r: error: {exc}", err=True)
             ctx.exit(exc.exit_code)
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:

@@ -11,8 +11,12 @@ class Rend3rError(Exception):
     """
 
     exit_code = 1
+    #: True when the message is already complete diagnostics (``file:line:col: error: ...``
+    #: with source lines and carets): the CLI prints it as it is, without its own prefix.
+    preformatted = False
 
-    def __init__(self, message: str, exit_code: int | None = None) -> None:
+    def __init__(self, message: str, exit_code: int | None = None, *, preformatted: bool = False) -> None:
         super().__init__(message)
         if exit_code is not None:
             self.exit_code = exit_code
+        self.preformatted = preformatted

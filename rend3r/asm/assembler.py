@@ -732,5 +732,5 @@ def assemble_or_raise(
     """Assemble a file, raising :class:`Rend3rError` with every diagnostic on errors."""
     result = assemble_file(path, include_paths, target, isa_ext=isa_ext)
     if not result.ok:
-        raise Rend3rError(result.format_diagnostics())
+        raise Rend3rError(result.format_diagnostics(), preformatted=True)
     return result

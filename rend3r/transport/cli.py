@@ -84,7 +84,18 @@ class _Progress:
 def send_command(program: str, mem_out: str | None, coe_out: str | None, iface: str | None,
                  pcap_out: str | None, port: str | None, mac: str, ethertype: str, framing: str,
                  baud: int, timeout: float, retries: int, run_after: bool, quiet: bool) -> None:
-    """Send PROGRAM (.asm source or any memory image) to a device or a file."""
+    """Send PROGRAM (.asm source or any memory image) to a device or a file.
+
+    Over --eth and --serial the load is acknowledged frame by frame and committed with
+    the program's CRC-32; the device keeps its previous program unless the commit matches.
+
+    \b
+    Examples:
+      rend3r send programs/sphere.asm --mem main.mem
+      rend3r send programs/sphere.asm --serial /dev/ttyUSB0 --baud 3000000 --run
+      rend3r send main.mem --eth enp3s0 --mac 69:69:5a:06:54:91
+      rend3r send programs/sphere.asm --pcap load.pcap
+    """
     targets = [(n, v) for n, v in (("--mem", mem_out), ("--coe", coe_out), ("--eth", iface),
                                    ("--pcap", pcap_out), ("--serial", port)) if v]
     if len(targets) != 1:
@@ -223,7 +234,16 @@ def serve(link: Link, core, stop: threading.Event, poll: float = 0.1) -> None:
 @click.option("--size", default="128x96", show_default=True, help="Rendered frame size WxH.")
 def device_command(iface: str | None, port: str | None, out_dir: str, mac: str, ethertype: str,
                    baud: int, max_words: int, max_frame_rate: float, max_frames: int, size: str) -> None:
-    """A virtual REND3R device: receive programs, run them, write each frame to DIR."""
+    """A virtual REND3R device: receive programs, run them, write each frame to DIR.
+
+    It applies the load protocol (docs/protocol.md), swaps in a program only when its
+    commit matches, renders it with the emulator and answers status. Ctrl-C stops it.
+
+    \b
+    Examples:
+      rend3r device --serial /dev/pts/5 -o frames/
+      rend3r device --eth veth1 -o frames/ --size 512x384
+    """
     from .device import DeviceCore
     from .execute import RenderExecutor, parse_size
 

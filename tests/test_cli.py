@@ -1,0 +1,33 @@
+"""The rend3r command group: lazy commands, start-up cost, how user errors are printed."""
+
+import subprocess
+import sys
+
+from click.testing import CliRunner
+
+from rend3r.cli import COMMANDS, main
+
+
+def test_every_registered_command_loads_and_has_an_example():
+    for name in COMMANDS:
+        result = CliRunner().invoke(main, [name, "--help"])
+        assert result.exit_code == 0, (name, result.output)
+        assert "Example" in result.output or "example" in result.output, name
+
+
+def test_help_imports_no_heavy_module():
+    code = "import sys; from rend3r.cli import main; print(sorted({'numpy', 'scapy', 'PIL', 'lark'} & set(sys.modules)))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
+
+
+def test_source_diagnostics_are_printed_once_without_a_second_prefix(tmp_path):
+    src = tmp_path / "bad.asm"
+    src.write_text("nr\ncam bogus, 1\ner\ner\n")
+    for args in (["emulate", str(src), "-o", str(tmp_path / "x.png")], ["send", str(src), "--mem", str(tmp_path / "x.mem")]):
+        result = CliRunner().invoke(main, args)
+        assert result.exit_code == 1
+        assert "rend3r: error:" not in result.output
+        assert f"{src}:2:5: error: unknown camera property 'bogus'" in result.output
+        assert result.output.count("unknown camera property") == 1
+    assert not (tmp_path / "x.png").exists() and not (tmp_path / "x.mem").exists()

@@ -11,9 +11,9 @@ from rend3r.asm.formats import FORMATS, read_words, render
 from rend3r.isa import CameraSet, LightSet, encode
 from rend3r.isa.tables import LIGHT_INDEX_LIMIT, MNEMONIC_TABLE, PROPERTIES, SHAPE_INDEX_LIMIT, Table, ValueType
 
-from .strategies import instructions, word_streams
+from rend3r.asm import assembler
 
-assembler = pytest.importorskip("rend3r.asm.assembler")
+from .strategies import instructions, word_streams
 
 MODES = ["raytrace", "raster"]
 

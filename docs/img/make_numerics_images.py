@@ -14,7 +14,8 @@ from PIL import Image, ImageDraw, ImageFont
 
 from rend3r.emu import EmuOptions
 from rend3r.golden.catalog import read_header
-from rend3r.golden.metrics import diff_image, rgb565_to_rgb888
+from rend3r.emu.image import rgb565_to_rgb888
+from rend3r.golden.metrics import diff_image
 from rend3r.golden.render_all import render_example
 
 ROOT = Path(__file__).resolve().parents[2]

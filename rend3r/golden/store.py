@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fileio import write_atomic
+
 MANIFEST = "manifest.json"
 #: Size of the golden renderings: the device's own 512x384. A program may name a smaller
 #: ``test-size`` in its header when rendering it at full size would slow the suite down.
@@ -51,4 +53,4 @@ class GoldenManifest:
     def save(self) -> None:
         data = {"format": HASH_FORMAT, "precision": "fp16", "subnormals": "ftz", "programs": dict(sorted(self.programs.items()))}
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.path.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
+        write_atomic(self.path, (json.dumps(data, indent=2) + "\n").encode("utf-8"))

@@ -17,8 +17,8 @@ from rend3r.golden.metrics import (
     interior_mask,
     provenance_metrics,
     region_interior_mask,
-    rgb565_to_rgb888,
 )
+from rend3r.emu.image import rgb565_to_rgb888
 
 
 def test_rgb565_bit_replication() -> None:

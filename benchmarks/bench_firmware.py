@@ -28,12 +28,12 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "bench.json"
         runner = get_runner("icarus")
-        runner.build(sources=sorted((FIRMWARE / "rtl").glob("*.v")), includes=[FIRMWARE / "rtl"],
-                     hdl_toplevel="rend3r_loader", parameters={"AW": 10, "CLKS_PER_BIT": 434},
+        runner.build(sources=[*sorted((FIRMWARE / "rtl").glob("*.v")), FIRMWARE / "tests" / "tb_loader.v"],
+                     includes=[FIRMWARE / "rtl"], hdl_toplevel="tb_loader", parameters={"AW": 10, "CLKS_PER_BIT": 434},
                      build_dir=tmp, timescale=("1ns", "1ps"))
         start = time.perf_counter()
         sys.path.insert(0, str(FIRMWARE / "tests"))  # the runner passes sys.path to the simulator
-        runner.test(test_module="bench_loader", hdl_toplevel="rend3r_loader", build_dir=tmp,
+        runner.test(test_module="bench_loader", hdl_toplevel="tb_loader", build_dir=tmp,
                     test_dir=tmp, extra_env={"BENCH_OUT": str(out), "LOADER_AW": "10",
                                              "LOADER_CPB": "434"})
         wall = time.perf_counter() - start

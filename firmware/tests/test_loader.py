@@ -12,7 +12,6 @@ import random
 from pathlib import Path
 
 import cocotb
-from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, Timer
 
 from rend3r.transport.device import DeviceCore
@@ -37,8 +36,7 @@ def assembled(name: str) -> list[int]:
 
 
 async def bring_up(dut) -> Pins:
-    """Clock, reset, idle lines, monitors."""
-    cocotb.start_soon(Clock(dut.clk, 20, unit="ns").start())  # 50 MHz
+    """Reset, idle lines, monitors (tb_loader.v makes the 50 MHz clock)."""
     dut.rst.value = 1
     dut.rmii_crs_dv.value = 0
     dut.rmii_rxd.value = 0
@@ -210,12 +208,12 @@ async def rmii_filters(dut):
     st = Frame(FrameType.STATUS, 0, 7).encode()
     await pins.send_rmii(wire_bytes(eth_for(st, dst=bytes.fromhex("69695a065492"))))
     await pins.send_rmii(wire_bytes(eth_for(st, ethertype=0x0800)))
-    await ClockCycles(dut.clk, 800)
+    await Timer(CLOCK_NS * 800, "ns")
     assert pins.replies == []
     broken = bytearray(wire_bytes(eth_for(st)))
     broken[-1] ^= 1  # FCS
     await pins.send_rmii(bytes(broken))
-    await ClockCycles(dut.clk, 800)
+    await Timer(CLOCK_NS * 800, "ns")
     assert pins.replies == []
     await pins.send_rmii(wire_bytes(eth_for(st, dst=b"\xff" * 6)))
     r = await sender.reply_to(Frame(FrameType.STATUS, 0, 7))
@@ -269,7 +267,7 @@ async def replies_match_reference(dut):
         expected = core.handle(data)
         await sender.put(data)
         if expected is None:
-            await ClockCycles(dut.clk, sender.timeout)
+            await Timer(CLOCK_NS * sender.timeout, "ns")
             assert pins.replies == [], f"step {i}: unexpected reply"
             continue
         got = await sender.reply_to(Frame(f.type, f.load, f.seq))
@@ -291,7 +289,7 @@ async def rmii_back_to_back(dut):
     start = cocotb.utils.get_sim_time("ns")
     for f in frames[:-1]:
         await sender.put(f.encode())  # minimum inter-frame gap, no waiting for ACKs
-    await ClockCycles(dut.clk, 400)
+    await Timer(CLOCK_NS * 400, "ns")
     acked = {r.seq for r in pins.replies if r.type == FrameType.ACK}
     assert acked == {f.seq for f in frames[:-1]}
     pins.replies.clear()

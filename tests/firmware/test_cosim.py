@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 FIRMWARE = Path(__file__).resolve().parents[2] / "firmware"
-RTL = sorted((FIRMWARE / "rtl").glob("*.v"))
+SOURCES = [*sorted((FIRMWARE / "rtl").glob("*.v")), FIRMWARE / "tests" / "tb_loader.v"]
 
 if shutil.which("iverilog") is None or shutil.which("vvp") is None:
     pytest.skip("Icarus Verilog (iverilog, vvp) is not installed: apt-get install iverilog",
@@ -20,11 +20,11 @@ runner_mod = pytest.importorskip("cocotb_tools.runner", reason="cocotb 2.x is no
 def build_and_run(tmp: Path, params: dict[str, int], env: dict[str, str]) -> None:
     """Build rend3r_loader with ``params`` and run firmware/tests/test_loader.py against it."""
     runner = runner_mod.get_runner("icarus")
-    runner.build(sources=RTL, includes=[FIRMWARE / "rtl"], hdl_toplevel="rend3r_loader",
+    runner.build(sources=SOURCES, includes=[FIRMWARE / "rtl"], hdl_toplevel="tb_loader",
                  parameters=params, build_dir=tmp, timescale=("1ns", "1ps"))
     sys.path.insert(0, str(FIRMWARE / "tests"))  # the runner passes sys.path to the simulator
     try:
-        results = runner.test(test_module="test_loader", hdl_toplevel="rend3r_loader",
+        results = runner.test(test_module="test_loader", hdl_toplevel="tb_loader",
                               build_dir=tmp, test_dir=tmp, extra_env=env)
     finally:
         sys.path.remove(str(FIRMWARE / "tests"))

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import os
 import random
+import subprocess
+import sys
 from pathlib import Path
 
 import cocotb
@@ -297,3 +299,47 @@ async def rmii_back_to_back(dut):
     assert r.type == FrameType.ACK
     dut._log.info("loaded %d words in %d ns", len(words), cocotb.utils.get_sim_time("ns") - start)
     await check_loaded(pins, sender, words)
+
+
+def pcap_frames(path: Path) -> list[bytes]:
+    """The packets of a pcap file (link type Ethernet, no FCS)."""
+    data = path.read_bytes()
+    assert int.from_bytes(data[:4], "little") == 0xA1B2C3D4, "little-endian microsecond pcap"
+    out, pos = [], 24
+    while pos < len(data):
+        incl = int.from_bytes(data[pos + 8:pos + 12], "little")
+        out.append(data[pos + 16:pos + 16 + incl])
+        pos += 16 + incl
+    return out
+
+
+@cocotb.test()
+async def rmii_replays_rend3r_send_pcap(dut):
+    """The frames `rend3r send --pcap --run` writes load and run the program.
+
+    They are replayed at the minimum gap, except that RUN waits for COMMIT's ACK, as
+    `rend3r send` waits on a live link: the COMMIT's CRC pass keeps the engine busy.
+    """
+    pins = await bring_up(dut)
+    pcap = Path(os.environ.get("TMPDIR", "/tmp")) / f"rend3r_firmware_{os.getpid()}.pcap"
+    try:
+        subprocess.run([sys.executable, "-m", "rend3r", "send", str(REPO / "programs" / "tri_cube.asm"),
+                        "--pcap", str(pcap), "--run"], check=True, capture_output=True)
+        frames = pcap_frames(pcap)
+    finally:
+        pcap.unlink(missing_ok=True)
+    for eth in frames:
+        if eth[15] == FrameType.RUN:
+            for _ in range(1 << AW):
+                if len(pins.replies) == len(frames) - 1:
+                    break
+                await Timer(CLOCK_NS * 16, "ns")
+        await pins.send_rmii(wire_bytes(eth))
+    await Timer(CLOCK_NS * 400, "ns")
+    assert len(pins.replies) == len(frames)
+    assert all(r.type == FrameType.ACK for r in pins.replies)
+    assert [r.ref for r in pins.replies] == [FrameType.BEGIN] + [FrameType.DATA] * (len(frames) - 3) \
+        + [FrameType.COMMIT, FrameType.RUN]
+    words = assembled("tri_cube.asm")
+    assert await pins.read_memory(len(words)) == words
+    assert dut.running.value == 1

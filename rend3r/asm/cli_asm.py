@@ -87,8 +87,6 @@ def asm_command(src: Path, out: str | None, formats: tuple[str, ...], include_di
     rendered = {fmt: render(fmt, result.program, byteorder=byteorder) for fmt in fmts}
     for fmt, path in paths.items():
         if path is None:
-            stream = click.get_binary_stream("stdout")
-            stream.write(rendered[fmt])
-            stream.flush()
+            click.echo(rendered[fmt], nl=False)  # bytes go to the binary stdout
         else:
             write_atomic(path, rendered[fmt])

@@ -64,11 +64,11 @@ class Bounds:
 
 def shape_bounds(shapes: Shapes) -> Bounds:
     """The world-to-normal-space map is |q|^2 * diag(s) * R^T: singular values |q|^2 |s_i|."""
-    q2 = sum(np.asarray(c, np.float64) ** 2 for c in shapes.rot)
-    s = np.abs(np.stack([np.asarray(c, np.float64) for c in shapes.inv_scale], axis=1))
-    center = np.stack([np.asarray(c, np.float64) for c in shapes.loc], axis=1)
-    smin, smax = q2 * s.min(axis=1), q2 * s.max(axis=1)
-    with np.errstate(all="ignore"):
+    with np.errstate(all="ignore"):  # inf * 0 in degenerate shapes: not cullable below
+        q2 = sum(np.asarray(c, np.float64) ** 2 for c in shapes.rot)
+        s = np.abs(np.stack([np.asarray(c, np.float64) for c in shapes.inv_scale], axis=1))
+        center = np.stack([np.asarray(c, np.float64) for c in shapes.loc], axis=1)
+        smin, smax = q2 * s.min(axis=1), q2 * s.max(axis=1)
         ok = (shapes.kind == SPHERE) & np.isfinite(center).all(axis=1) & (smin >= 2.0**-6) & (smax <= 2.0**6)
     return Bounds(center, smin, smax, ok)
 

@@ -136,17 +136,21 @@ def _i(index: int, name: str, title: str, bits: int) -> Property:
 
 
 _ZERO = Property(0, "zero", "zero", ValueType.ZERO)
+#: Location and quaternion rotation: indices 1-7 of both the camera and the shape table.
+_PLACEMENT = (
+    _f(1, "xloc", "x-location"),
+    _f(2, "yloc", "y-location"),
+    _f(3, "zloc", "z-location"),
+    _f(4, "rrot", "rotation-r"),
+    _f(5, "irot", "rotation-i", "iro"),
+    _f(6, "jrot", "rotation-j"),
+    _f(7, "krot", "rotation-k"),
+)
 
 PROPERTIES: dict[Table, tuple[Property, ...]] = {
     Table.CAMERA: (
         _ZERO,
-        _f(1, "xloc", "x-location"),
-        _f(2, "yloc", "y-location"),
-        _f(3, "zloc", "z-location"),
-        _f(4, "rrot", "rotation-r"),
-        _f(5, "irot", "rotation-i", "iro"),
-        _f(6, "jrot", "rotation-j"),
-        _f(7, "krot", "rotation-k"),
+        *_PLACEMENT,
         _f(8, "nclip", "near-clip"),
         _f(9, "fclip", "far-clip"),
         _f(10, "hfov", "fov-horizontal"),
@@ -165,13 +169,7 @@ PROPERTIES: dict[Table, tuple[Property, ...]] = {
     ),
     Table.SHAPE: (
         _ZERO,
-        _f(1, "xloc", "x-location"),
-        _f(2, "yloc", "y-location"),
-        _f(3, "zloc", "z-location"),
-        _f(4, "rrot", "rotation-r"),
-        _f(5, "irot", "rotation-i", "iro"),
-        _f(6, "jrot", "rotation-j"),
-        _f(7, "krot", "rotation-k"),
+        *_PLACEMENT,
         _f(8, "xscl", "x-scale-inv"),
         _f(9, "yscl", "y-scale-inv"),
         _f(10, "zscl", "z-scale-inv"),

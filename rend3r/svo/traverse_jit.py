@@ -28,7 +28,7 @@ _CACHE = os.environ.get("REND3R_JIT_CACHE", "1") != "0"
 _TRACE_PER_RAY = 16
 
 
-@njit(cache=_CACHE, nogil=True)
+@njit(cache=_CACHE, nogil=True, inline="always")
 def _first_index(t00, t01, t02, t10, t11, t12):
     """FIRSTINDEX(t_enter, t_m): bit a set where the entry lies beyond the middle plane."""
     enter = max(max(t00, t01), t02)
@@ -42,7 +42,7 @@ def _first_index(t00, t01, t02, t10, t11, t12):
     return idx
 
 
-@njit(cache=_CACHE, nogil=True)
+@njit(cache=_CACHE, nogil=True, inline="always")
 def _popcount8(x):
     x = x & 0xFF
     x = x - ((x >> 1) & 0x55)
@@ -75,7 +75,7 @@ def _clamp(x):
     return x
 
 
-@njit(cache=_CACHE, nogil=True)
+@njit(cache=_CACHE, nogil=True, boundscheck=False, error_model="numpy")
 def _kernel(words, origin, direction, root_table, stack_depth, limit, record):
     """Set up and trace every ray; see :func:`trace_fixed`.
 
@@ -98,7 +98,9 @@ def _kernel(words, origin, direction, root_table, stack_depth, limit, record):
     out_rest = np.zeros(n, dtype=np.int32)
     out_lvl = np.zeros(n, dtype=np.int8)
     out_stack = np.zeros(n, dtype=np.int8)
-    cap = n * _TRACE_PER_RAY + 16 if record else 1
+    cap = 1
+    if record is not None:
+        cap = n * _TRACE_PER_RAY + 16
     rec_ray = np.empty(cap, dtype=np.int64)
     rec_addr = np.empty(cap, dtype=np.int64)
     rec_lvl = np.empty(cap, dtype=np.int64)
@@ -144,7 +146,7 @@ def _kernel(words, origin, direction, root_table, stack_depth, limit, record):
         maxlvl = 0
         maxstack = 0
         idx = _first_index(t00, t01, t02, t10, t11, t12)
-        if record:
+        if record is not None:
             if nrec + 1 > rec_ray.shape[0]:
                 rec_ray = _grow(rec_ray, nrec + 1)
                 rec_addr = _grow(rec_addr, nrec + 1)
@@ -192,7 +194,7 @@ def _kernel(words, origin, direction, root_table, stack_depth, limit, record):
                 lvl = level + 1
                 requests += 1 + isfar
                 descents += 1
-                if record:
+                if record is not None:
                     if nrec + 2 > rec_ray.shape[0]:
                         rec_ray = _grow(rec_ray, nrec + 2)
                         rec_addr = _grow(rec_addr, nrec + 2)
@@ -262,7 +264,7 @@ def _kernel(words, origin, direction, root_table, stack_depth, limit, record):
                 idx = _first_index(t00, t01, t02, t10, t11, t12)
                 restarts += 1
                 requests += 1
-                if record:
+                if record is not None:
                     if nrec + 1 > rec_ray.shape[0]:
                         rec_ray = _grow(rec_ray, nrec + 1)
                         rec_addr = _grow(rec_addr, nrec + 1)
@@ -295,4 +297,4 @@ def trace_fixed(words: np.ndarray, origin: np.ndarray, direction: np.ndarray, ro
     return _kernel(np.ascontiguousarray(words, dtype=np.uint32),
                    np.ascontiguousarray(origin, dtype=np.float64),
                    np.ascontiguousarray(direction, dtype=np.float64),
-                   int(root_table), int(stack_depth), int(limit), bool(record))
+                   int(root_table), int(stack_depth), int(limit), 1 if record else None)

@@ -81,6 +81,10 @@ def _kernel(words, origin, direction, root_table, stack_depth, limit, record):
 
     The ray setup repeats :func:`rend3r.svo.traverse.setup_rays` operation for operation
     (the same float64 operations in the same order, hence the same roundings).
+    ``record`` is ``None`` for the fast variant or any int to record the request trace:
+    numba compiles one machine-code version per argument type and prunes every
+    ``record is not None`` branch at compile time, so the fast loop carries no recording
+    code or trace buffers.
     """
     n = origin.shape[0]
     S = stack_depth

@@ -58,6 +58,19 @@ def _grow(buf, need):
     return out
 
 
+@njit(cache=_CACHE, nogil=True, inline="always")
+def _record(rec_ray, rec_addr, rec_lvl, nrec, ray, addr, lvl):
+    """Append one memory request (ray, word address, level) to the trace buffers."""
+    if nrec + 1 > rec_ray.shape[0]:
+        rec_ray = _grow(rec_ray, nrec + 1)
+        rec_addr = _grow(rec_addr, nrec + 1)
+        rec_lvl = _grow(rec_lvl, nrec + 1)
+    rec_ray[nrec] = ray
+    rec_addr[nrec] = addr
+    rec_lvl[nrec] = lvl
+    return rec_ray, rec_addr, rec_lvl, nrec + 1
+
+
 @njit(cache=_CACHE, nogil=True)
 def _to_fixed(x):
     """16.16 rounding of :func:`rend3r.svo.fixed.to_fixed` (round half to even)."""
@@ -151,14 +164,7 @@ def _kernel(words, origin, direction, root_table, stack_depth, limit, record):
         maxstack = 0
         idx = _first_index(t00, t01, t02, t10, t11, t12)
         if record is not None:
-            if nrec + 1 > rec_ray.shape[0]:
-                rec_ray = _grow(rec_ray, nrec + 1)
-                rec_addr = _grow(rec_addr, nrec + 1)
-                rec_lvl = _grow(rec_lvl, nrec + 1)
-            rec_ray[nrec] = r
-            rec_addr[nrec] = 0
-            rec_lvl[nrec] = 0
-            nrec += 1
+            rec_ray, rec_addr, rec_lvl, nrec = _record(rec_ray, rec_addr, rec_lvl, nrec, r, 0, 0)
         while True:
             steps += 1
             if steps > limit:
@@ -199,19 +205,9 @@ def _kernel(words, origin, direction, root_table, stack_depth, limit, record):
                 requests += 1 + isfar
                 descents += 1
                 if record is not None:
-                    if nrec + 2 > rec_ray.shape[0]:
-                        rec_ray = _grow(rec_ray, nrec + 2)
-                        rec_addr = _grow(rec_addr, nrec + 2)
-                        rec_lvl = _grow(rec_lvl, nrec + 2)
-                    rec_ray[nrec] = r
-                    rec_addr[nrec] = caddr
-                    rec_lvl[nrec] = lvl
-                    nrec += 1
+                    rec_ray, rec_addr, rec_lvl, nrec = _record(rec_ray, rec_addr, rec_lvl, nrec, r, caddr, lvl)
                     if isfar:
-                        rec_ray[nrec] = r
-                        rec_addr[nrec] = slot
-                        rec_lvl[nrec] = lvl
-                        nrec += 1
+                        rec_ray, rec_addr, rec_lvl, nrec = _record(rec_ray, rec_addr, rec_lvl, nrec, r, slot, lvl)
                 if S:
                     top = top + 1 if top + 1 < S else 0
                     s_word[top] = word
@@ -269,14 +265,7 @@ def _kernel(words, origin, direction, root_table, stack_depth, limit, record):
                 restarts += 1
                 requests += 1
                 if record is not None:
-                    if nrec + 1 > rec_ray.shape[0]:
-                        rec_ray = _grow(rec_ray, nrec + 1)
-                        rec_addr = _grow(rec_addr, nrec + 1)
-                        rec_lvl = _grow(rec_lvl, nrec + 1)
-                    rec_ray[nrec] = r
-                    rec_addr[nrec] = 0
-                    rec_lvl[nrec] = 0
-                    nrec += 1
+                    rec_ray, rec_addr, rec_lvl, nrec = _record(rec_ray, rec_addr, rec_lvl, nrec, r, 0, 0)
         out_req[r] = requests
         out_steps[r] = steps
         out_desc[r] = descents

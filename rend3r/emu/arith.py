@@ -39,6 +39,16 @@ class Arith:
         return np.float64 if self.precision == "fp64" else np.float32
 
     @property
+    def unit_roundoff(self) -> float:
+        """Half an ulp of 1: the largest relative error of one rounding (normal range)."""
+        return {"fp16": 2.0**-11, "fp32": 2.0**-24, "fp64": 2.0**-53}[self.precision]
+
+    @property
+    def tiny(self) -> float:
+        """The smallest normal number: below it results flush or lose relative precision."""
+        return {"fp16": 2.0**-14, "fp32": 2.0**-126, "fp64": 2.0**-1022}[self.precision]
+
+    @property
     def label(self) -> str:
         if self.precision == "fp16":
             return f"fp16-{'ftz' if self.ftz else 'ieee'}"

@@ -13,6 +13,7 @@ is tested against every pixel.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Iterator
 
 import numpy as np
@@ -42,10 +43,19 @@ class Tiles:
         return len(self.count)
 
 
-def make_tiles(pixels: np.ndarray, width: int) -> Tiles:
-    """Group active pixels (flat indices) into TILE x TILE screen tiles (empty ones dropped)."""
-    tx, ty = (pixels % width) // TILE, (pixels // width) // TILE
-    key = ty * ((width + TILE - 1) // TILE) + tx
+@lru_cache(maxsize=8)
+def screen_tiles(pixels: int, width: int, tile: int = TILE) -> Tiles:
+    """The tiles of a whole frame (they depend on its size only)."""
+    tiles = make_tiles(np.arange(pixels), width, tile)
+    for a in (tiles.order, tiles.start, tiles.count, tiles.of_pixel):
+        a.flags.writeable = False
+    return tiles
+
+
+def make_tiles(pixels: np.ndarray, width: int, tile: int = TILE) -> Tiles:
+    """Group active pixels (flat indices) into tile x tile screen tiles (empty ones dropped)."""
+    tx, ty = (pixels % width) // tile, (pixels // width) // tile
+    key = ty * ((width + tile - 1) // tile) + tx
     order = np.argsort(key, kind="stable")
     key = key[order]
     uniq, start, count = np.unique(key, return_index=True, return_counts=True)
@@ -98,33 +108,80 @@ def _unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return v / n[..., None], n
 
 
-def _tile_reduce(tiles: Tiles, values: np.ndarray, op: np.ufunc) -> np.ndarray:
+def tile_reduce(tiles: Tiles, values: np.ndarray, op: np.ufunc) -> np.ndarray:
     """Reduce per-pixel values (in tile order) to one value per tile."""
     return op.reduceat(values, tiles.start, axis=0)
 
 
-def cone_keep(tiles: Tiles, apex: np.ndarray, dirs: np.ndarray, origins: np.ndarray | None,
-              b: Bounds, sel: np.ndarray, fp16: bool) -> np.ndarray:
-    """(tiles, len(sel)) mask: rays through ``apex`` with the tile's directions may hit.
+@dataclass(frozen=True)
+class Cones:
+    """Per tile, a double cone holding its rays' directions, and their shortest length."""
 
-    ``dirs`` are the rays' directions and ``origins`` their origins (None: the apex
-    itself), per active pixel in tile order.
-    """
+    axis: np.ndarray  # (tiles, 3) unit axis
+    half: np.ndarray  # (tiles,) half-angle
+    dmin: np.ndarray  # (tiles, 1) shortest direction
+
+
+def tile_cones(tiles: Tiles, dirs: np.ndarray) -> Cones:
+    """The cones of rays with directions ``dirs`` (per active pixel, in tile order)."""
     unit, length = _unit(dirs)
-    axis, _ = _unit(_tile_reduce(tiles, unit, np.add))
+    axis, _ = _unit(tile_reduce(tiles, unit, np.add))
     cos = np.einsum("ij,ij->i", unit, axis[tiles.of_pixel])
-    half = np.arccos(np.clip(_tile_reduce(tiles, cos, np.minimum), -1.0, 1.0)) + 1e-7
+    half = np.arccos(np.clip(tile_reduce(tiles, cos, np.minimum), -1.0, 1.0)) + 1e-7
     half = np.where(np.isfinite(axis).all(axis=1), half, np.pi)
-    dmin = _tile_reduce(tiles, length, np.minimum)[:, None]
+    return Cones(axis, half, tile_reduce(tiles, length, np.minimum)[:, None])
+
+
+def cone_keep(tiles: Tiles, cones: Cones, apex: np.ndarray, origins: np.ndarray | None,
+              b: Bounds, sel: np.ndarray, fp16: bool) -> np.ndarray:
+    """(tiles, len(sel)) mask: rays through ``apex`` within the tiles' cones may hit.
+
+    ``origins`` are the rays' origins per active pixel in tile order (None: the apex).
+    """
     v = b.center[sel] - apex
     vunit, vlen = _unit(v)
-    dist = _origin_distance(tiles, origins, b.center[sel]) if origins is not None else vlen[None, :]
-    r = cull_radius(b, sel, dist, dmin, fp16)
-    phi = np.arccos(np.clip(axis @ vunit.T, -1.0, 1.0))
-    phi = np.minimum(phi, np.pi - phi)  # lines, not half-lines
+    if origins is None:  # one bound per shape: the shortest direction of all tiles is the worst case
+        r = cull_radius(b, sel, vlen[None, :], cones.dmin.min(), fp16)
+    else:
+        r = cull_radius(b, sel, _origin_distance(tiles, origins, b.center[sel]), cones.dmin, fp16)
     with np.errstate(all="ignore"):
-        spread = np.arcsin(np.clip(r / vlen[None, :], 0.0, 1.0))
-    return (vlen[None, :] <= r) | (phi <= half[:, None] + spread + 1e-7) | ~np.isfinite(r)
+        spread = np.arcsin(np.clip(r / vlen[None, :], 0.0, 1.0)) + 1e-7
+    # angle(axis, centre line) <= half + spread, for lines (not half-lines), compared as
+    # |cos angle| >= cos(half + spread) = cos(half) cos(spread) - sin(half) sin(spread)
+    half = cones.half[:, None]
+    reach = np.cos(half) * np.cos(spread) - np.sin(half) * np.sin(spread)
+    near = np.abs(cones.axis @ vunit.T) >= reach
+    return near | (half + spread >= np.pi / 2) | (vlen[None, :] <= r) | ~np.isfinite(r)
+
+
+def depth_floor(b: Bounds, apex: np.ndarray, dmin: float, u: float, tiny: float) -> np.ndarray:
+    """Per shape, a lower bound of the computed ``sq_dist`` of any hit by a ray from ``apex``.
+
+    0 where no bound is claimed (shapes that are not cullable spheres, apex inside or near
+    the shape). ``dmin`` bounds the rays' direction lengths from below, ``u`` is the unit
+    roundoff and ``tiny`` the smallest normal number (below it results may flush or lose
+    precision). Derivation: ``docs/emulator.md`` section 7.
+    """
+    with np.errstate(all="ignore"):
+        smin, smax = b.smin, b.smax
+        dlo = smin * dmin
+        uu = u + tiny / np.minimum(1.0, np.minimum(dlo * dlo, dmin * dmin))
+        e = 32.0 * uu * (1.0 + smax / smin)  # transform error, relative (twice section 7's)
+        dist = np.linalg.norm(b.center - apex, axis=1)
+        s_lo, s_hi = smin * dist * (1.0 - _SLACK) * (1.0 - e), smax * dist * (1.0 + _SLACK) * (1.0 + e)
+        d_lo, d_hi = smin * (1.0 - e), smax * (1.0 + e)  # per unit world direction length
+        b_max = 2.0 * d_hi * s_hi * (1.0 + 4.0 * uu)
+        a_lo, a_hi = 2.0 * d_lo**2 * (1.0 - 4.0 * uu), 2.0 * d_hi**2 * (1.0 + 4.0 * uu)
+        c_lo = 2.0 * (s_lo**2 - 1.0) - 8.0 * uu * (s_hi**2 + 1.0)
+        alpha, beta = (1.0 + uu) ** 4, (1.0 - uu) ** 4
+        ac = a_lo * c_lo
+        b_min = np.sqrt(np.maximum(0.0, ((1.0 - uu) * ac - tiny) / (1.0 + uu)))  # else disc < 0
+        def num(bb):  # B - sqrt(alpha B^2 - beta a c): rises, then falls, with B
+            return bb - np.sqrt(np.maximum(0.0, alpha * bb * bb - beta * ac))
+        t_lo = (1.0 - uu) ** 2 * np.minimum(num(b_min), num(b_max)) / a_hi
+        floor = (1.0 - uu) ** 6 * (1.0 - 4.0 * uu) * t_lo**2 * (1.0 - _SLACK)
+        ok = b.cullable & (dlo >= 2.0**-4) & (e < 0.25) & (c_lo > 0) & (b_min > 0) & (t_lo >= 2.0**-13)
+        return np.where(ok & np.isfinite(floor), floor, 0.0)
 
 
 def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: Bounds, sel: np.ndarray,
@@ -142,8 +199,8 @@ def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: B
     e2 = np.cross(d, e1)
     basis = np.stack([e1, e2], axis=1)
     p2 = origins @ basis
-    lo = _tile_reduce(tiles, p2, np.minimum)
-    hi = _tile_reduce(tiles, p2, np.maximum)
+    lo = tile_reduce(tiles, p2, np.minimum)
+    hi = tile_reduce(tiles, p2, np.maximum)
     centers = b.center[sel]
     c2 = centers @ basis
     gap = np.maximum(0.0, np.maximum(lo[:, None, :] - c2[None], c2[None] - hi[:, None, :]))
@@ -151,8 +208,8 @@ def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: B
     r = cull_radius(b, sel, dist, np.full((len(tiles), 1), dlen), fp16)
     keep = (np.linalg.norm(gap, axis=2) <= r) | ~np.isfinite(r)
     # behind: min over the tile of (origin - centre).d, and the nearest origin's distance
-    ahead = _tile_reduce(tiles, origins @ d, np.minimum)[:, None] - (centers @ d)[None, :]
-    lo3, hi3 = _tile_reduce(tiles, origins, np.minimum), _tile_reduce(tiles, origins, np.maximum)
+    ahead = tile_reduce(tiles, origins @ d, np.minimum)[:, None] - (centers @ d)[None, :]
+    lo3, hi3 = tile_reduce(tiles, origins, np.minimum), tile_reduce(tiles, origins, np.maximum)
     near = np.linalg.norm(np.maximum(0.0, np.maximum(lo3[:, None] - centers[None], centers[None] - hi3[:, None])), axis=2)
     smin, smax = b.smin[sel], b.smax[sel]
     with np.errstate(all="ignore"):
@@ -165,8 +222,8 @@ def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: B
 
 def _origin_distance(tiles: Tiles, origins: np.ndarray, centers: np.ndarray) -> np.ndarray:
     """(tiles, shapes): an upper bound of |origin - centre| over each tile's origins."""
-    lo = _tile_reduce(tiles, origins, np.minimum)
-    hi = _tile_reduce(tiles, origins, np.maximum)
+    lo = tile_reduce(tiles, origins, np.minimum)
+    hi = tile_reduce(tiles, origins, np.maximum)
     mid, half = (lo + hi) / 2, np.linalg.norm(hi - lo, axis=1) / 2
     return np.linalg.norm(centers[None] - mid[:, None], axis=2) + half[:, None]
 
@@ -187,8 +244,9 @@ def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray) -> Iterator[tuple[np.
         lo = hi
 
 
-def shape_blocks(n: int, tiles: int) -> Iterator[np.ndarray]:
-    """Shape positions in blocks that keep a (tiles, block) matrix modest."""
-    step = max(1, (1 << 21) // max(1, tiles))
+def shape_blocks(n: int, tiles: int, order: np.ndarray | None = None) -> Iterator[np.ndarray]:
+    """Shape positions (in ``order`` if given) in blocks that keep a (tiles, block) matrix
+    modest, and that are small enough for depth culling to act between blocks."""
+    step = max(1, min((1 << 21) // max(1, tiles), max(64, -(-n // 16))))
     for lo in range(0, n, step):
-        yield np.arange(lo, min(n, lo + step))
+        yield np.arange(lo, min(n, lo + step)) if order is None else order[lo:lo + step]

@@ -39,6 +39,10 @@ def _decode_at(words: Sequence[int], addr: int):
     return decode_word(word), 1
 
 
+def _where(pc: int) -> str:
+    return f"address {pc} (0x{pc:04x})"
+
+
 def execute(
     words: Sequence[int],
     options: EmuOptions,
@@ -62,19 +66,18 @@ def execute(
         if pc not in decoded:
             decoded[pc] = _decode_at(words, pc)
         ins, size = decoded[pc]
-        here = f"address {pc} (0x{pc:04x})"
         executed += 1
         if isinstance(ins, Unknown):
             selected = decode_table_select(ins.word) if options.mode == "hybrid" else None
             if selected is None:
                 hint = ("; it is a TS table-select word (docs/isa-extensions.md): run with --mode hybrid"
                         if decode_table_select(ins.word) is not None else "")
-                raise Rend3rError(f"{here}: unknown opcode 0b{OPCODE.get(ins.word):03b} in word 0x{ins.word:08x}{hint}")
+                raise Rend3rError(f"{_where(pc)}: unknown opcode 0b{OPCODE.get(ins.word):03b} in word 0x{ins.word:08x}{hint}")
             table = selected
             pc += size
             continue
         if isinstance(ins, TrailingSE):
-            raise Rend3rError(f"{here}: SE word 0x{ins.word:08x} is the last word; its SD is missing")
+            raise Rend3rError(f"{_where(pc)}: SE word 0x{ins.word:08x} is the last word; its SD is missing")
         pc += size
         if isinstance(ins, CameraSet):
             scene.set_camera(ins)
@@ -99,10 +102,10 @@ def execute(
             else:  # LR
                 if frames is None:
                     raise Rend3rError(
-                        f"{here}: the program loops (lr); pass --frames N to bound how many frames to render"
+                        f"{_where(pc - size)}: the program loops (lr); pass --frames N to bound how many frames to render"
                     )
                 if count == frames_at_last_lr:
-                    raise Rend3rError(f"{here}: the program loops (lr) without rendering a frame (no nf in the loop)")
+                    raise Rend3rError(f"{_where(pc - size)}: the program loops (lr) without rendering a frame (no nf in the loop)")
                 frames_at_last_lr = count
                 pc = options.lr_target
     return Execution(count, executed, "end")

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import os
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from functools import lru_cache
 from time import perf_counter
 from typing import Callable
 
@@ -16,14 +18,15 @@ import numpy as np
 
 from .arith import Arith
 from .camera import camera_rays
-from .cull import PAIR_CHUNK, Bounds, Tiles, cone_keep, make_tiles, pairs, parallel_keep, shape_blocks, shape_bounds
+from .cull import (PAIR_CHUNK, Bounds, cone_keep, depth_floor, make_tiles, pairs, parallel_keep, screen_tiles, shape_blocks,
+                   shape_bounds, tile_cones, tile_reduce)
 from .frame import Frame
 from .lighting import Recorder, diffuse
 from .lights import POINT, Light, lights_from_scene
 from .options import EmuOptions
 from .scene import Scene
 from .shapes import (Form, Shapes, direction_term, origin_term, shapes_from_scene, solve, squared_distance, surface,
-                     to_object, transform_classes)
+                     to_object, transform_classes, uniform_form)
 from .stats import FrameStats
 from .vec import Vec, dot
 
@@ -48,14 +51,20 @@ def _parallel(fn, items):
     if _WORKERS < 2:
         yield from map(fn, items)
         return
-    with ThreadPoolExecutor(_WORKERS) as pool:
-        pending = []
-        for item in items:
-            pending.append(pool.submit(fn, item))
-            if len(pending) > 2 * _WORKERS:
-                yield pending.pop(0).result()
-        for f in pending:
-            yield f.result()
+    pool = _pool()
+    pending = []
+    for item in items:
+        pending.append(pool.submit(fn, item))
+        if len(pending) > 2 * _WORKERS:
+            yield pending.pop(0).result()
+    for f in pending:
+        yield f.result()
+
+
+@lru_cache(maxsize=1)
+def _pool() -> ThreadPoolExecutor:
+    """One pool for the process: frames submit many small batches."""
+    return ThreadPoolExecutor(_WORKERS, thread_name_prefix="rend3r-raytrace")
 
 
 class _Nearest:
@@ -108,9 +117,7 @@ def render_frame(
             if tables is None:
                 _, Dh = to_object(ar, s, None, D)
             else:
-                cls, n, tab = tables
-                row = cls[sl] * n + px
-                Dh = (tab[0][row], tab[1][row], tab[2][row])
+                Dh, _ = tables.read(sl, px)
             return surface(ar, s, _take(S_shape, sl), Dh, near.t[px], rays.origin, D)
 
         parts = list(_parallel(hit_surface, [(lo, lo + PAIR_CHUNK) for lo in range(0, len(hp), PAIR_CHUNK)]))
@@ -130,12 +137,31 @@ def render_frame(
     return frame, st
 
 
+#: Primary rays are culled in smaller tiles than shadow rays: depth culling then acts on
+#: tiles whose pixels all have a hit, and the cones are tighter.
+PRIMARY_TILE = 16
+
 #: Per-class direction tables are built when classes * pixels stays below this.
 _CLASS_TABLE_LIMIT = 1 << 23
 
 
-def _direction_tables(ar: Arith, shapes: Shapes, direction: Vec):
-    """Normal-space directions and a2 per (transform class, pixel), or None if too large.
+@dataclass(frozen=True)
+class _DirectionTables:
+    """Normal-space directions (x, y, z) and a2 per (transform class, pixel)."""
+
+    cls: np.ndarray  # class of each shape
+    single: bool  # one class: rows are pixels
+    n: int  # pixels
+    columns: list[np.ndarray]
+
+    def read(self, slot: np.ndarray, pix: np.ndarray) -> tuple[Vec, np.ndarray]:
+        row = pix if self.single else self.cls[slot] * self.n + pix
+        c = self.columns
+        return (c[0][row], c[1][row], c[2][row]), c[3][row]
+
+
+def _direction_tables(ar: Arith, shapes: Shapes, direction: Vec) -> _DirectionTables | None:
+    """The direction tables, or None when classes * pixels is too large.
 
     A pair then reads its class's row instead of repeating the rotation: bit-identical,
     since it is the same sequence of operations on the same values.
@@ -152,8 +178,7 @@ def _direction_tables(ar: Arith, shapes: Shapes, direction: Vec):
 
     jobs = [(rep, lo, min(n, lo + PAIR_CHUNK)) for rep in first for lo in range(0, n, PAIR_CHUNK)]
     parts = list(_parallel(row, jobs))
-    tables = [np.concatenate([p[k] for p in parts]) for k in range(4)]
-    return cls, n, tables
+    return _DirectionTables(cls, len(first) == 1, n, [np.concatenate([p[k] for p in parts]) for k in range(4)])
 
 
 def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: Bounds,
@@ -166,24 +191,37 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
     S_shape, _ = to_object(ar, shapes, rays.origin, None)
     c2_shape = origin_term(ar, shapes, S_shape)
     tables = _direction_tables(ar, shapes, rays.direction)
-    tiles = make_tiles(np.arange(n_pix), options.width)
+    form = uniform_form(shapes)
+    tiles = screen_tiles(n_pix, options.width, PRIMARY_TILE)
     fp16 = ar.precision == "fp16"
     apex = _f64(rays.origin)[0]
-    dirs = _f64(rays.direction)[tiles.order] if options.cull else None
-    blocks = list(shape_blocks(len(shapes), len(tiles)))
+    floor = order = cones = None
+    if options.cull:
+        cones = tile_cones(tiles, _f64(rays.direction)[tiles.order])
+        floor = depth_floor(bounds, apex, float(cones.dmin.min()), ar.unit_roundoff, ar.tiny)
+        order = np.argsort(floor, kind="stable")  # front to back: near hits then skip far shapes
+    blocks = list(shape_blocks(len(shapes), len(tiles), order))
     for done, sel in enumerate(blocks):
-        keep = cone_keep(tiles, apex, dirs, None, bounds, sel, fp16) if options.cull else np.ones((len(tiles), len(sel)), bool)
+        if options.cull:
+            keep = cone_keep(tiles, cones, apex, None, bounds, sel, fp16)
+            # depth: a shape whose every hit is farther than a pixel's nearest so far cannot win it
+            reached = near.sqd.copy()
+            keep &= floor[sel][None, :] <= tile_reduce(tiles, reached[tiles.order], np.maximum)[:, None]
+        else:
+            keep, reached = np.ones((len(tiles), len(sel)), bool), None
+
         def test(batch):
             pix, slot = batch
+            if reached is not None:
+                live = floor[slot] <= reached[pix]
+                pix, slot = pix[live], slot[live]
             if tables is None:
                 s = shapes.take(slot)
                 _, Dh = to_object(ar, s, None, _take(rays.direction, pix))
                 a2 = None
             else:
-                s = Form(shapes.zsign[slot])
-                cls, n, tab = tables
-                row = cls[slot] * n + pix
-                Dh, a2 = (tab[0][row], tab[1][row], tab[2][row]), tab[3][row]
+                s = form or Form(shapes.zsign[slot])
+                Dh, a2 = tables.read(slot, pix)
             sol = solve(ar, s, _take(S_shape, slot), Dh, c2_shape[slot], rays.tmin, rays.tmax, a2)
             sqd = squared_distance(ar, dd[pix], sol.t)
             bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
@@ -233,7 +271,7 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
         org = _f64(origin)[tiles.order]
         if light.kind == POINT:
             apex = _f64(light.location)[0]
-            dirs = _f64(direction)[tiles.order]
+            cones = tile_cones(tiles, _f64(direction)[tiles.order])
     per_shape = None
     if light.kind != POINT:  # one direction for every shadow ray: its normal-space terms per shape
         _, D_shape = to_object(ar, shapes, None, direction)
@@ -242,7 +280,7 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
         if not options.cull:
             keep = np.ones((len(tiles), len(sel)), bool)
         elif light.kind == POINT:
-            keep = cone_keep(tiles, apex, dirs, org, bounds, sel, fp16)
+            keep = cone_keep(tiles, cones, apex, org, bounds, sel, fp16)
         else:
             keep = parallel_keep(tiles, _f64(direction)[0], org, bounds, sel, fp16)
         def test(batch):

@@ -20,10 +20,12 @@ def prop_index(table: Table, name: str) -> int:
     return prop.index
 
 
+#: Per table, the null properties (``zero``): writing them stores nothing.
+_NULL_PROPS = {t: frozenset(i for i, p in by_index(t).items() if p.vtype is ValueType.ZERO) for t in Table}
+
+
 def _writes(table: Table, prop: int) -> bool:
-    """The null property (``zero``) writes nothing."""
-    p = by_index(table).get(prop)
-    return p is None or p.vtype is not ValueType.ZERO
+    return prop not in _NULL_PROPS[table]
 
 
 @dataclass
@@ -59,8 +61,9 @@ class Scene:
         ``store`` is ``objects`` unless given (hybrid mode's ``triangles``).
         """
         target = self.objects if store is None else store
+        null = _NULL_PROPS[table]
         for prop, data in ((ins.prop, ins.data), (ins.prop2, ins.data2)):
-            if _writes(table, prop):
+            if prop not in null:
                 target.setdefault(ins.index, {})[prop] = data
 
     def camera_bits(self, name: str, default: int = 0) -> int:

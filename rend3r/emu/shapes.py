@@ -58,9 +58,11 @@ def shapes_from_scene(scene: Scene, arith: Arith) -> Shapes:
         "xloc", "yloc", "zloc", "rrot", "irot", "jrot", "krot", "xscl", "yscl", "zscl", "col", "type")}
     rows = sorted((i, props) for i, props in scene.objects.items() if props.get(p["type"], 0) & _TYPE.value_mask in NORMAL_FORMS)
     n = len(rows)
+    names = list(p)
+    table = np.array([[props.get(p[name], 0) for name in names] for _, props in rows], dtype=np.uint16).reshape(n, len(names))
 
     def bits(name: str) -> np.ndarray:
-        return np.fromiter((props.get(p[name], 0) for _, props in rows), dtype=np.uint16, count=n)
+        return table[:, names.index(name)].copy()
 
     kind = bits("type") & _TYPE.value_mask
     rot = [bits(n) for n in ("rrot", "irot", "jrot", "krot")]
@@ -95,8 +97,19 @@ class Form:
 
 def _zterm(s: Shapes | Form, p: np.ndarray) -> np.ndarray:
     """The z product as the shape type uses it: kept, dropped (0) or negated."""
+    if np.ndim(s.zsign) == 0:  # one normal form for every pair (e.g. all spheres)
+        if s.zsign == 1:
+            return p
+        if s.zsign == 0:
+            return np.zeros_like(p)
     with np.errstate(invalid="ignore"):
         return np.where(s.zsign == 0, np.zeros((), p.dtype), p * s.zsign)
+
+
+def uniform_form(s: Shapes) -> Form | None:
+    """The shapes' common normal form as a scalar :class:`Form`, or None if they differ."""
+    z = s.zsign
+    return Form(z[0]) if len(z) and (z == z[0]).all() else None
 
 
 def origin_term(ar: Arith, s: Shapes, S: Vec) -> np.ndarray:
@@ -152,11 +165,19 @@ def solve(ar: Arith, s: Shapes | Form, S: Vec, D: Vec, c2: np.ndarray, tmin: np.
     nb = ar.neg(b)
     t1 = ar.div(ar.sub(nb, root), a2)
     t2 = ar.div(ar.add(nb, root), a2)
-    bad = ~_finite(a2, b, c2, disc) | (real & ~_finite(t1, t2))
-    ok1 = real & (t1 > 0) & (t1 >= tmin)
-    ok2 = real & (t2 > 0) & (t2 >= tmin)
+    # disc = b*b - a2*c2 is finite exactly when a2, b, c2 and disc all are (an infinite or
+    # NaN input makes a product infinite or NaN, and the difference with it)
+    bad = ~np.isfinite(disc) | (real & ~_finite(t1, t2))
+    if np.ndim(tmin) == 0:  # accepted: t > 0 and t >= tmin, which a scalar tmin makes one test
+        above = (lambda v: v >= tmin) if tmin > 0 else (lambda v: v > 0)
+    else:
+        above = lambda v: (v > 0) & (v >= tmin)  # noqa: E731
+    ok1, ok2 = real & above(t1), real & above(t2)
     t = np.where(ok1, t1, t2)
-    hit = (ok1 | ok2) & (t <= tmax) & ~bad
+    hit = ok1 | ok2
+    if not (np.ndim(tmax) == 0 and tmax == np.inf):  # t <= inf holds for every accepted, finite t
+        hit &= t <= tmax
+    hit &= ~bad
     return Solution(hit, t, bad, a2, b, disc, root, t1, t2)
 
 

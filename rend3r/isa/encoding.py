@@ -28,14 +28,14 @@ from .tables import (
 )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class FrameOp:
     """F-type: er, nr, nf, lr."""
 
     func: Func
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class CameraSet:
     """C-type: camera[prop] = data."""
 
@@ -43,7 +43,7 @@ class CameraSet:
     data: int
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class LightSet:
     """L-type: light[index][prop] = data."""
 
@@ -52,7 +52,7 @@ class LightSet:
     data: int
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ShapeSet:
     """SE/SD pair: shape or triangle [index]: prop = data, then prop2 = data2."""
 
@@ -63,14 +63,14 @@ class ShapeSet:
     data2: int
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Unknown:
     """A word with an opcode the device does not execute (010, 100, 110, 111)."""
 
     word: int
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class TrailingSE:
     """An SE word at the end of the stream, with no SD after it."""
 
@@ -107,18 +107,21 @@ def decode_word(word: int, sd: int | None = None) -> Decoded:
     For an SE word, ``sd`` is the following word; None makes it a TrailingSE.
     """
     op = OPCODE.get(word)
-    if op == Opcode.F:
-        return FrameOp(Func(FUNC.get(word)))
-    if op == Opcode.C:
-        return CameraSet(PROP.get(word), DATA.get(word))
-    if op == Opcode.L:
-        return LightSet(LIGHT_INDEX.get(word), PROP.get(word), DATA.get(word))
-    if op == Opcode.SE:
+    if op == _SE:
         if sd is None:
             return TrailingSE(word)
         index = (SE_INDEX_HI.get(word) << 3) | SE_INDEX_LO.get(word)
         return ShapeSet(index, PROP.get(word), SE_PROP2.get(word), SD_DATA.get(sd), SD_DATA2.get(sd))
+    if op == _F:
+        return FrameOp(Func(FUNC.get(word)))
+    if op == _C:
+        return CameraSet(PROP.get(word), DATA.get(word))
+    if op == _L:
+        return LightSet(LIGHT_INDEX.get(word), PROP.get(word), DATA.get(word))
     return Unknown(word)
+
+
+_F, _C, _L, _SE = (int(o) for o in (Opcode.F, Opcode.C, Opcode.L, Opcode.SE))  # plain ints: cheaper compares
 
 
 def decode_stream(words: Iterable[int]) -> Iterator[tuple[int, Decoded]]:

@@ -7,7 +7,7 @@ Sources: the paper's Figures 2-4 and ``shared/docs/original-device.md``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum, IntEnum
 
 
@@ -40,6 +40,10 @@ class Field:
 
     hi: int
     lo: int
+    _low_mask: int = field(init=False, repr=False, compare=False)  # decode runs per word: precomputed
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_low_mask", (1 << self.width) - 1)
 
     @property
     def width(self) -> int:
@@ -47,10 +51,10 @@ class Field:
 
     @property
     def mask(self) -> int:
-        return ((1 << self.width) - 1) << self.lo
+        return self._low_mask << self.lo
 
     def get(self, word: int) -> int:
-        return (word >> self.lo) & ((1 << self.width) - 1)
+        return (word >> self.lo) & self._low_mask
 
     def put(self, value: int) -> int:
         if not 0 <= value < (1 << self.width):

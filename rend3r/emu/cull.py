@@ -18,12 +18,26 @@ from typing import Iterator
 
 import numpy as np
 
+from .arith import Arith
 from .shapes import SPHERE, Shapes
 
 TILE = 16  # pixels per tile side
 PAIR_CHUNK = 1 << 16  # pixel-shape pairs per batch: temporaries stay cache-sized
-U16 = 2.0**-11  # float16 unit roundoff
-FTZ = 2.0**-14  # largest absolute error of one flush to zero
+
+@dataclass(frozen=True)
+class Rounding:
+    """What the bounds need of the working precision: unit roundoff, smallest normal
+    number (the largest absolute error of a flush or an underflow), and whether float16's
+    overflow limit applies."""
+
+    u: float
+    tiny: float
+    fp16: bool
+
+    @classmethod
+    def of(cls, ar: Arith) -> "Rounding":
+        return cls(ar.unit_roundoff, ar.tiny, ar.precision == "fp16")
+
 _SLACK = 1e-9
 #: A finite float16 a2*c2 is below 65520; with the coefficients' rounding error allowed for,
 #: |D|^2 (|S|^2 - 1) stays below 16380 * 1.02.
@@ -44,18 +58,18 @@ class Tiles:
 
 
 @lru_cache(maxsize=8)
-def screen_tiles(pixels: int, width: int, tile: int = TILE) -> Tiles:
+def screen_tiles(pixels: int, width: int) -> Tiles:
     """The tiles of a whole frame (they depend on its size only)."""
-    tiles = make_tiles(np.arange(pixels), width, tile)
+    tiles = make_tiles(np.arange(pixels), width)
     for a in (tiles.order, tiles.start, tiles.count, tiles.of_pixel):
         a.flags.writeable = False
     return tiles
 
 
-def make_tiles(pixels: np.ndarray, width: int, tile: int = TILE) -> Tiles:
-    """Group active pixels (flat indices) into tile x tile screen tiles (empty ones dropped)."""
-    tx, ty = (pixels % width) // tile, (pixels // width) // tile
-    key = ty * ((width + tile - 1) // tile) + tx
+def make_tiles(pixels: np.ndarray, width: int) -> Tiles:
+    """Group active pixels (flat indices) into TILE x TILE screen tiles (empty ones dropped)."""
+    tx, ty = (pixels % width) // TILE, (pixels // width) // TILE
+    key = ty * ((width + TILE - 1) // TILE) + tx
     order = np.argsort(key, kind="stable")
     key = key[order]
     uniq, start, count = np.unique(key, return_index=True, return_counts=True)
@@ -83,7 +97,7 @@ def shape_bounds(shapes: Shapes) -> Bounds:
     return Bounds(center, smin, smax, ok)
 
 
-def cull_radius(b: Bounds, sel: np.ndarray, dist: np.ndarray, dmin: np.ndarray, fp16: bool) -> np.ndarray:
+def cull_radius(b: Bounds, sel: np.ndarray, dist: np.ndarray, dmin: np.ndarray, rnd: Rounding) -> np.ndarray:
     """World radius beyond which no ray line can hit, for shapes ``sel``.
 
     ``dist`` bounds the distance from ray origins to the centre, ``dmin`` the direction
@@ -93,9 +107,9 @@ def cull_radius(b: Bounds, sel: np.ndarray, dist: np.ndarray, dmin: np.ndarray, 
     with np.errstate(all="ignore"):
         smin, smax = b.smin[sel], b.smax[sel]
         dhat = smin * dmin  # |D| in normal space, at least
-        u = U16 + FTZ / np.minimum(1.0, dhat * dhat)
+        u = rnd.u + rnd.tiny / np.minimum(1.0, dhat * dhat)
         m = smax * dist
-        if fp16:
+        if rnd.fp16:
             m = np.minimum(m, np.sqrt(1.0 + F16_PRODUCT_LIMIT / (dhat * dhat)))
         h = np.sqrt(1.0 + 24.0 * u * (1.0 + m * m)) + 16.0 * u * m * (1.0 + smax / smin)
         r = h / smin * (1.0 + _SLACK) + _SLACK
@@ -132,8 +146,33 @@ def tile_cones(tiles: Tiles, dirs: np.ndarray) -> Cones:
     return Cones(axis, half, tile_reduce(tiles, length, np.minimum)[:, None])
 
 
+def grid_cones(x: np.ndarray, y: np.ndarray, z: float, tiles: Tiles, width: int) -> Cones:
+    """:func:`tile_cones` of screen tiles whose directions are the grid (x[column], y[row], z).
+
+    A tile's directions lie in the rectangle spanned by its x and y ranges at height z, so
+    the cone through the rectangle's corners holds them all (a cone of half-angle below
+    pi/2 is convex), and the rectangle's point nearest the axis bounds their length.
+    """
+    first = tiles.order[tiles.start]  # each tile's first (top-left) pixel
+    c0, r0 = first % width, first // width
+    xs, ys = np.asarray(x, np.float64), np.asarray(y, np.float64)
+    def span(v: np.ndarray, lo: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        blocks = np.pad(v, (0, -len(v) % TILE), mode="edge").reshape(-1, TILE)
+        return blocks.min(axis=1)[lo // TILE], blocks.max(axis=1)[lo // TILE]
+    (xlo, xhi), (ylo, yhi) = span(xs, c0), span(ys, r0)
+    corners = np.stack([np.stack(np.broadcast_arrays(cx, cy, z), axis=-1)
+                        for cx in (xlo, xhi) for cy in (ylo, yhi)], axis=1)  # (tiles, 4, 3)
+    unit, _ = _unit(corners)
+    axis, _ = _unit(unit.sum(axis=1))
+    cos = np.einsum("tkj,tj->tk", unit, axis).min(axis=1)
+    half = np.arccos(np.clip(cos, -1.0, 1.0)) + 1e-7
+    half = np.where(np.isfinite(axis).all(axis=1) & (half < np.pi / 2), half, np.pi)
+    nearest = np.stack(np.broadcast_arrays(np.clip(0.0, xlo, xhi), np.clip(0.0, ylo, yhi), z), axis=-1)
+    return Cones(axis, half, np.linalg.norm(nearest, axis=1)[:, None])
+
+
 def cone_keep(tiles: Tiles, cones: Cones, apex: np.ndarray, origins: np.ndarray | None,
-              b: Bounds, sel: np.ndarray, fp16: bool) -> np.ndarray:
+              b: Bounds, sel: np.ndarray, rnd: Rounding) -> np.ndarray:
     """(tiles, len(sel)) mask: rays through ``apex`` within the tiles' cones may hit.
 
     ``origins`` are the rays' origins per active pixel in tile order (None: the apex).
@@ -141,9 +180,9 @@ def cone_keep(tiles: Tiles, cones: Cones, apex: np.ndarray, origins: np.ndarray 
     v = b.center[sel] - apex
     vunit, vlen = _unit(v)
     if origins is None:  # one bound per shape: the shortest direction of all tiles is the worst case
-        r = cull_radius(b, sel, vlen[None, :], cones.dmin.min(), fp16)
+        r = cull_radius(b, sel, vlen[None, :], cones.dmin.min(), rnd)
     else:
-        r = cull_radius(b, sel, _origin_distance(tiles, origins, b.center[sel]), cones.dmin, fp16)
+        r = cull_radius(b, sel, _origin_distance(tiles, origins, b.center[sel]), cones.dmin, rnd)
     with np.errstate(all="ignore"):
         spread = np.arcsin(np.clip(r / vlen[None, :], 0.0, 1.0)) + 1e-7
     # angle(axis, centre line) <= half + spread, for lines (not half-lines), compared as
@@ -154,18 +193,18 @@ def cone_keep(tiles: Tiles, cones: Cones, apex: np.ndarray, origins: np.ndarray 
     return near | (half + spread >= np.pi / 2) | (vlen[None, :] <= r) | ~np.isfinite(r)
 
 
-def depth_floor(b: Bounds, apex: np.ndarray, dmin: float, u: float, tiny: float) -> np.ndarray:
+def depth_floor(b: Bounds, apex: np.ndarray, dmin: float, rnd: Rounding) -> np.ndarray:
     """Per shape, a lower bound of the computed ``sq_dist`` of any hit by a ray from ``apex``.
 
     0 where no bound is claimed (shapes that are not cullable spheres, apex inside or near
-    the shape). ``dmin`` bounds the rays' direction lengths from below, ``u`` is the unit
-    roundoff and ``tiny`` the smallest normal number (below it results may flush or lose
-    precision). Derivation: ``docs/emulator.md`` section 7.
+    the shape). ``dmin`` bounds the rays' direction lengths from below. Derivation:
+    ``docs/emulator.md`` section 7.
     """
+    tiny = rnd.tiny
     with np.errstate(all="ignore"):
         smin, smax = b.smin, b.smax
         dlo = smin * dmin
-        uu = u + tiny / np.minimum(1.0, np.minimum(dlo * dlo, dmin * dmin))
+        uu = rnd.u + tiny / np.minimum(1.0, np.minimum(dlo * dlo, dmin * dmin))
         e = 32.0 * uu * (1.0 + smax / smin)  # transform error, relative (twice section 7's)
         dist = np.linalg.norm(b.center - apex, axis=1)
         s_lo, s_hi = smin * dist * (1.0 - _SLACK) * (1.0 - e), smax * dist * (1.0 + _SLACK) * (1.0 + e)
@@ -185,7 +224,7 @@ def depth_floor(b: Bounds, apex: np.ndarray, dmin: float, u: float, tiny: float)
 
 
 def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: Bounds, sel: np.ndarray,
-                  fp16: bool) -> np.ndarray:
+                  rnd: Rounding) -> np.ndarray:
     """(tiles, len(sel)) mask: parallel rays (t > 0) from the tile's origins (tile order) may hit.
 
     A shape is skipped when it is off every ray line (as in :func:`cone_keep`), or when it
@@ -205,7 +244,7 @@ def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: B
     c2 = centers @ basis
     gap = np.maximum(0.0, np.maximum(lo[:, None, :] - c2[None], c2[None] - hi[:, None, :]))
     dist = _origin_distance(tiles, origins, centers)
-    r = cull_radius(b, sel, dist, np.full((len(tiles), 1), dlen), fp16)
+    r = cull_radius(b, sel, dist, np.full((len(tiles), 1), dlen), rnd)
     keep = (np.linalg.norm(gap, axis=2) <= r) | ~np.isfinite(r)
     # behind: min over the tile of (origin - centre).d, and the nearest origin's distance
     ahead = tile_reduce(tiles, origins @ d, np.minimum)[:, None] - (centers @ d)[None, :]
@@ -213,7 +252,7 @@ def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: B
     near = np.linalg.norm(np.maximum(0.0, np.maximum(lo3[:, None] - centers[None], centers[None] - hi3[:, None])), axis=2)
     smin, smax = b.smin[sel], b.smax[sel]
     with np.errstate(all="ignore"):
-        u = U16 + FTZ / np.minimum(1.0, (smin * dlen) ** 2)
+        u = rnd.u + rnd.tiny / np.minimum(1.0, (smin * dlen) ** 2)
         mean2, spread2 = (smax**2 + smin**2) / 2, (smax**2 - smin**2) / 2
         ds_low = dlen * (mean2 * ahead - (spread2 + 64.0 * u * smax**2) * dist)  # computed D.S stays above
         behind = (ds_low > 2.0**-6) & (near > r) & np.isfinite(r)

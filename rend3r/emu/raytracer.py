@@ -18,7 +18,7 @@ import numpy as np
 
 from .arith import Arith
 from .camera import camera_rays
-from .cull import (PAIR_CHUNK, Bounds, cone_keep, depth_floor, make_tiles, pairs, parallel_keep, screen_tiles, shape_blocks,
+from .cull import (PAIR_CHUNK, Bounds, Rounding, cone_keep, depth_floor, grid_cones, make_tiles, pairs, parallel_keep, screen_tiles, shape_blocks,
                    shape_bounds, tile_cones, tile_reduce)
 from .frame import Frame
 from .lighting import Recorder, diffuse
@@ -74,8 +74,10 @@ class _Nearest:
         self.sqd = np.full(n, np.inf, dtype=dtype)
         self.slot = np.full(n, _NONE, dtype=np.int64)
         self.t = np.full(n, np.nan, dtype=dtype)  # the winner's t
+        self.hits = 0  # hits merged so far
 
     def update(self, pix: np.ndarray, slot: np.ndarray, sqd: np.ndarray, t: np.ndarray | None = None) -> None:
+        self.hits += len(pix)
         before = self.sqd[pix]
         np.minimum.at(self.sqd, pix, sqd)
         now = self.sqd[pix]
@@ -112,8 +114,10 @@ def render_frame(
         def hit_surface(job):
             lo, hi = job
             px, sl = hp[lo:hi], slot[lo:hi]
-            s = shapes.take(sl)
             D = _take(rays.direction, px)
+            if not lights:  # unlit: the point alone (for NaN checks), no normal
+                return surface(ar, None, None, None, near.t[px], rays.origin, D, normals=False)
+            s = shapes.take(sl)
             if tables is None:
                 _, Dh = to_object(ar, s, None, D)
             else:
@@ -123,7 +127,7 @@ def render_frame(
         parts = list(_parallel(hit_surface, [(lo, lo + PAIR_CHUNK) for lo in range(0, len(hp), PAIR_CHUNK)]))
         empty = (np.zeros(0, ar.dtype),) * 3
         point, normal = (tuple(np.concatenate([p[k][a] for p in parts]) if parts else empty[a] for a in range(3))
-                         for k in range(2))
+                         if k == 0 or lights else None for k in range(2))
         color, bad = shade_hits(ar, options, shapes, bounds, lights, hp, slot, point, normal, st, nan_pixel)
         nan_pixel[hp[bad]] = True
         hp, slot = hp[~bad], slot[~bad]
@@ -136,10 +140,6 @@ def render_frame(
     frame = Frame(number, rgb.reshape(h, w), depth.reshape(h, w), prov.reshape(h, w))
     return frame, st
 
-
-#: Primary rays are culled in smaller tiles than shadow rays: depth culling then acts on
-#: tiles whose pixels all have a hit, and the cones are tighter.
-PRIMARY_TILE = 16
 
 #: Per-class direction tables are built when classes * pixels stays below this.
 _CLASS_TABLE_LIMIT = 1 << 23
@@ -192,21 +192,23 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
     c2_shape = origin_term(ar, shapes, S_shape)
     tables = _direction_tables(ar, shapes, rays.direction)
     form = uniform_form(shapes)
-    tiles = screen_tiles(n_pix, options.width, PRIMARY_TILE)
-    fp16 = ar.precision == "fp16"
+    tiles = screen_tiles(n_pix, options.width)
+    rnd = Rounding.of(ar)
     apex = _f64(rays.origin)[0]
     floor = order = cones = None
     if options.cull:
-        cones = tile_cones(tiles, _f64(rays.direction)[tiles.order])
-        floor = depth_floor(bounds, apex, float(cones.dmin.min()), ar.unit_roundoff, ar.tiny)
+        cones = (grid_cones(*rays.grid, tiles, options.width) if rays.grid is not None
+                 else tile_cones(tiles, _f64(rays.direction)[tiles.order]))
+        floor = depth_floor(bounds, apex, float(cones.dmin.min()), rnd)
         order = np.argsort(floor, kind="stable")  # front to back: near hits then skip far shapes
     blocks = list(shape_blocks(len(shapes), len(tiles), order))
     for done, sel in enumerate(blocks):
         if options.cull:
-            keep = cone_keep(tiles, cones, apex, None, bounds, sel, fp16)
+            keep = cone_keep(tiles, cones, apex, None, bounds, sel, rnd)
             # depth: a shape whose every hit is farther than a pixel's nearest so far cannot win it
-            reached = near.sqd.copy()
-            keep &= floor[sel][None, :] <= tile_reduce(tiles, reached[tiles.order], np.maximum)[:, None]
+            reached = near.sqd.copy() if near.hits else None
+            if reached is not None:
+                keep &= floor[sel][None, :] <= tile_reduce(tiles, reached[tiles.order], np.maximum)[:, None]
         else:
             keep, reached = np.ones((len(tiles), len(sel)), bool), None
 
@@ -265,7 +267,7 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
     tmax = ar.const(1.0 if light.kind == POINT else np.inf)
     tmin = ar.const(0.0)
     tiles = make_tiles(pix, options.width)
-    fp16 = ar.precision == "fp16"
+    rnd = Rounding.of(ar)
     before = st.tests
     if options.cull:
         org = _f64(origin)[tiles.order]
@@ -280,9 +282,9 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
         if not options.cull:
             keep = np.ones((len(tiles), len(sel)), bool)
         elif light.kind == POINT:
-            keep = cone_keep(tiles, cones, apex, org, bounds, sel, fp16)
+            keep = cone_keep(tiles, cones, apex, org, bounds, sel, rnd)
         else:
-            keep = parallel_keep(tiles, _f64(direction)[0], org, bounds, sel, fp16)
+            keep = parallel_keep(tiles, _f64(direction)[0], org, bounds, sel, rnd)
         def test(batch):
             pos, slot = batch
             other = slot != own[pos]

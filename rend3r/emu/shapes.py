@@ -192,9 +192,13 @@ def transform_classes(s: Shapes) -> tuple[np.ndarray, np.ndarray]:
     return first, cls.reshape(-1)
 
 
-def surface(ar: Arith, s: Shapes, S: Vec, D: Vec, t: np.ndarray, origin: Vec, direction: Vec) -> tuple[Vec, Vec]:
-    """World hit point origin + t*d, and world normal (object normal scaled, rotated by q)."""
+def surface(ar: Arith, s: Shapes | None, S: Vec | None, D: Vec | None, t: np.ndarray, origin: Vec, direction: Vec,
+            normals: bool = True) -> tuple[Vec, Vec | None]:
+    """World hit point origin + t*d, and world normal (object normal scaled, rotated by q;
+    None when ``normals`` is false: unlit scenes need none)."""
     point = madd3(ar, origin, t, direction)
+    if not normals:
+        return point, None
     P = madd3(ar, S, t, D)
     normal_obj = (P[0], P[1], _zterm(s, P[2]))
     normal = rotate(ar, s.rot, mul3(ar, normal_obj, s.inv_scale))

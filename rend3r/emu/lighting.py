@@ -22,7 +22,7 @@ from .vec import Vec, dot, sub3
 Occluder = Callable[[Light, np.ndarray, Vec], np.ndarray]
 #: Trace hook: (stage name, values per point) for every intermediate, in order.
 Recorder = Callable[[str, np.ndarray], None]
-_MAX = np.array([31, 63, 31])
+_CHANNELS = ((11, 31), (5, 63), (0, 31))  # RGB565: (shift, largest value) per channel
 #: The device's intensity converter: I * 2**14 into a 13-bit signed integer.
 FIXED_SCALE, FIXED_BITS = 16384, 13
 
@@ -54,8 +54,8 @@ def diffuse(
     bad = ~(np.isfinite(point[0]) & np.isfinite(point[1]) & np.isfinite(point[2]))
     if not lights:
         return base, bad
-    channels = np.stack([base >> 11, (base >> 5) & 0x3F, base & 0x1F], axis=1).astype(np.float64)
-    acc = np.zeros_like(channels)
+    channels = [((base >> shift) & top).astype(np.float64) for shift, top in _CHANNELS]
+    acc = [np.zeros(len(base)) for _ in _CHANNELS]
     nn = ar.sqrt(dot(ar, normal, normal))
     for light in lights:
         tag = f"L{light.index}."
@@ -88,8 +88,10 @@ def diffuse(
             shadow = occluded(light, lit, tuple(c[lit] if np.ndim(c) else c for c in l_vec))
             rec(tag + "shadow", shadow)
             lit = lit[~shadow]
-        lc = light.color
-        scale = np.array([(lc >> 11) / 31.0, ((lc >> 5) & 0x3F) / 63.0, (lc & 0x1F) / 31.0])
-        acc[lit] += factor[lit, None] * channels[lit] * scale
-    ch = np.clip(np.floor(acc + 0.5), 0, _MAX).astype(np.uint16)
-    return (ch[:, 0] << 11) | (ch[:, 1] << 5) | ch[:, 2], bad
+        # unlit points weigh 0: adding 0 * channel * scale (= +0) leaves their sums as they are
+        weight = np.zeros(len(base))
+        weight[lit] = factor[lit]
+        for a, ch, (shift, top) in zip(acc, channels, _CHANNELS):
+            a += weight * ch * (((light.color >> shift) & top) / top)
+    r, g, b = (np.clip(np.floor(a + 0.5), 0, top).astype(np.uint16) for a, (_, top) in zip(acc, _CHANNELS))
+    return (r << 11) | (g << 5) | b, bad

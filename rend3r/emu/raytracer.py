@@ -7,10 +7,7 @@ cannot change a pixel. Colour arithmetic (after the float16 datapath): see
 
 from __future__ import annotations
 
-import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from functools import lru_cache
 from time import perf_counter
 from typing import Callable
 
@@ -18,8 +15,8 @@ import numpy as np
 
 from .arith import Arith
 from .camera import camera_rays
-from .cull import (PAIR_CHUNK, Bounds, Rounding, cone_keep, depth_floor, grid_cones, make_tiles, pairs, parallel_keep, screen_tiles, shape_blocks,
-                   shape_bounds, tile_cones, tile_reduce)
+from .cull import (PAIR_CHUNK, Bounds, Rounding, cone_keep, depth_floor, grid_cones, make_tiles, pairs, parallel_keep,
+                   screen_tiles, shape_blocks, shape_bounds, tile_cones, tile_reduce)
 from .frame import Frame
 from .lighting import Recorder, diffuse
 from .lights import POINT, Light, lights_from_scene
@@ -43,28 +40,6 @@ def _take(v: Vec, idx: np.ndarray) -> Vec:
     return tuple(c[idx] if np.ndim(c) else c for c in v)
 
 
-_WORKERS = min(4, os.cpu_count() or 1)
-
-
-def _parallel(fn, items):
-    """fn over items on worker threads (numpy releases the GIL), results in order."""
-    if _WORKERS < 2:
-        yield from map(fn, items)
-        return
-    pool = _pool()
-    pending = []
-    for item in items:
-        pending.append(pool.submit(fn, item))
-        if len(pending) > 2 * _WORKERS:
-            yield pending.pop(0).result()
-    for f in pending:
-        yield f.result()
-
-
-@lru_cache(maxsize=1)
-def _pool() -> ThreadPoolExecutor:
-    """One pool for the process: frames submit many small batches."""
-    return ThreadPoolExecutor(_WORKERS, thread_name_prefix="rend3r-raytrace")
 
 
 class _Nearest:
@@ -117,14 +92,15 @@ def render_frame(
             D = _take(rays.direction, px)
             if not lights:  # unlit: the point alone (for NaN checks), no normal
                 return surface(ar, None, None, None, near.t[px], rays.origin, D, normals=False)
-            s = shapes.take(sl)
             if tables is None:
+                s = shapes.take(sl)
                 _, Dh = to_object(ar, s, None, D)
-            else:
+            else:  # one transform class: its parameters broadcast, nothing to gather per hit
+                s = shapes.take(tables.first[:1] if tables.single else sl)
                 Dh, _ = tables.read(sl, px)
             return surface(ar, s, _take(S_shape, sl), Dh, near.t[px], rays.origin, D)
 
-        parts = list(_parallel(hit_surface, [(lo, lo + PAIR_CHUNK) for lo in range(0, len(hp), PAIR_CHUNK)]))
+        parts = [hit_surface((lo, lo + PAIR_CHUNK)) for lo in range(0, len(hp), PAIR_CHUNK)]
         empty = (np.zeros(0, ar.dtype),) * 3
         point, normal = (tuple(np.concatenate([p[k][a] for p in parts]) if parts else empty[a] for a in range(3))
                          if k == 0 or lights else None for k in range(2))
@@ -149,6 +125,7 @@ _CLASS_TABLE_LIMIT = 1 << 23
 class _DirectionTables:
     """Normal-space directions (x, y, z) and a2 per (transform class, pixel)."""
 
+    first: np.ndarray  # a representative shape of each class
     cls: np.ndarray  # class of each shape
     single: bool  # one class: rows are pixels
     n: int  # pixels
@@ -177,8 +154,8 @@ def _direction_tables(ar: Arith, shapes: Shapes, direction: Vec) -> _DirectionTa
         return (*Dh, direction_term(ar, s, Dh))
 
     jobs = [(rep, lo, min(n, lo + PAIR_CHUNK)) for rep in first for lo in range(0, n, PAIR_CHUNK)]
-    parts = list(_parallel(row, jobs))
-    return _DirectionTables(cls, len(first) == 1, n, [np.concatenate([p[k] for p in parts]) for k in range(4)])
+    parts = [row(job) for job in jobs]
+    return _DirectionTables(first, cls, len(first) == 1, n, [np.concatenate([p[k] for p in parts]) for k in range(4)])
 
 
 def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: Bounds,
@@ -229,8 +206,7 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
             bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
             return pix, slot, sqd, sol.t, sol.hit & ~bad, bad
 
-        # batches are independent; the nearest-hit merge is order-free (min, ties to index)
-        for pix, slot, sqd, t, hit, bad in _parallel(test, pairs(tiles, keep, sel)):
+        for pix, slot, sqd, t, hit, bad in map(test, pairs(tiles, keep, sel)):
             st.tests += len(pix)
             st.nan_tests += int(bad.sum())
             nan_pixel[pix[bad]] = True
@@ -299,7 +275,7 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
             sol = solve(ar, s, S, D, origin_term(ar, s, S), tmin, tmax, a2)
             return pos, sol.hit, sol.bad
 
-        for pos, hit, bad in _parallel(test, pairs(tiles, keep, sel)):
+        for pos, hit, bad in map(test, pairs(tiles, keep, sel)):
             st.tests += len(pos)
             st.nan_tests += int(bad.sum())
             nan_pixel[pix[pos[bad]]] = True

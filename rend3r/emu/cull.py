@@ -171,18 +171,18 @@ def grid_cones(x: np.ndarray, y: np.ndarray, z: float, tiles: Tiles, width: int)
     return Cones(axis, half, np.linalg.norm(nearest, axis=1)[:, None])
 
 
-def cone_keep(tiles: Tiles, cones: Cones, apex: np.ndarray, origins: np.ndarray | None,
+def cone_keep(cones: Cones, apex: np.ndarray, origins: Boxes | None,
               b: Bounds, sel: np.ndarray, rnd: Rounding) -> np.ndarray:
     """(tiles, len(sel)) mask: rays through ``apex`` within the tiles' cones may hit.
 
-    ``origins`` are the rays' origins per active pixel in tile order (None: the apex).
+    ``origins`` bounds the rays' origins per tile (None: the apex itself).
     """
     v = b.center[sel] - apex
     vunit, vlen = _unit(v)
     if origins is None:  # one bound per shape: the shortest direction of all tiles is the worst case
         r = cull_radius(b, sel, vlen[None, :], cones.dmin.min(), rnd)
     else:
-        r = cull_radius(b, sel, _origin_distance(tiles, origins, b.center[sel]), cones.dmin, rnd)
+        r = cull_radius(b, sel, origins.reach(b.center[sel]), cones.dmin, rnd)
     with np.errstate(all="ignore"):
         spread = np.arcsin(np.clip(r / vlen[None, :], 0.0, 1.0)) + 1e-7
     # angle(axis, centre line) <= half + spread, for lines (not half-lines), compared as
@@ -223,48 +223,81 @@ def depth_floor(b: Bounds, apex: np.ndarray, dmin: float, rnd: Rounding) -> np.n
         return np.where(ok & np.isfinite(floor), floor, 0.0)
 
 
-def parallel_keep(tiles: Tiles, direction: np.ndarray, origins: np.ndarray, b: Bounds, sel: np.ndarray,
-                  rnd: Rounding) -> np.ndarray:
-    """(tiles, len(sel)) mask: parallel rays (t > 0) from the tile's origins (tile order) may hit.
+@dataclass(frozen=True)
+class Boxes:
+    """Per tile, the bounding box of some points (e.g. its rays' origins): (tiles, k) arrays."""
+
+    lo: np.ndarray
+    hi: np.ndarray
+
+    def gap2(self, pts: np.ndarray) -> np.ndarray:
+        """(tiles, points): squared distance from each point to each box (0 inside)."""
+        total = np.zeros((len(self.lo), len(pts)))
+        for k in range(pts.shape[1]):
+            g = np.maximum(self.lo[:, k, None] - pts[None, :, k], pts[None, :, k] - self.hi[:, k, None])
+            np.maximum(g, 0.0, out=g)
+            total += g * g
+        return total
+
+    def reach(self, pts: np.ndarray) -> np.ndarray:
+        """(tiles, points): an upper bound of the distance from each point to any box point."""
+        mid, half = (self.lo + self.hi) / 2, np.linalg.norm(self.hi - self.lo, axis=1) / 2
+        total = np.zeros((len(self.lo), len(pts)))
+        for k in range(pts.shape[1]):
+            g = pts[None, :, k] - mid[:, k, None]
+            total += g * g
+        return np.sqrt(total) * (1.0 + _SLACK) + half[:, None]
+
+
+def tile_boxes(tiles: Tiles, points: np.ndarray) -> Boxes:
+    """The boxes of ``points`` (per active pixel, in tile order) over each tile."""
+    return Boxes(tile_reduce(tiles, points, np.minimum), tile_reduce(tiles, points, np.maximum))
+
+
+@dataclass(frozen=True)
+class ParallelRays:
+    """Rays sharing one direction, from per-pixel origins, summarised per tile."""
+
+    unit: np.ndarray  # the direction, normalised
+    length: float  # |direction|
+    basis: np.ndarray  # (3, 2): the plane normal to the direction
+    plane: Boxes  # origins projected onto that plane
+    space: Boxes  # origins
+    lead: np.ndarray  # (tiles,) min of origin . unit
+
+
+def parallel_rays(tiles: Tiles, direction: np.ndarray, origins: np.ndarray) -> ParallelRays:
+    """Summarise rays along ``direction`` from ``origins`` (per active pixel, tile order)."""
+    d, dlen = _unit(direction)
+    e1 = np.cross(d, [1.0, 0.0, 0.0] if abs(d[0]) < 0.9 else [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    basis = np.stack([e1, np.cross(d, e1)], axis=1)
+    return ParallelRays(d, float(dlen), basis, tile_boxes(tiles, origins @ basis), tile_boxes(tiles, origins),
+                        tile_reduce(tiles, origins @ d, np.minimum))
+
+
+def parallel_keep(rays: ParallelRays, b: Bounds, sel: np.ndarray, rnd: Rounding) -> np.ndarray:
+    """(tiles, len(sel)) mask: the tiles' parallel rays (t > 0) may hit the shapes.
 
     A shape is skipped when it is off every ray line (as in :func:`cone_keep`), or when it
     lies behind every origin: then the computed b = 2 D.S is positive and c2 too, so
     ``sqrt(b*b - a2*c2) <= b`` (sqrt(fl(b*b)) = |b| in round-to-nearest) and neither root
     is positive.
     """
-    d, dlen = _unit(direction)
-    e1 = np.cross(d, [1.0, 0.0, 0.0] if abs(d[0]) < 0.9 else [0.0, 1.0, 0.0])
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(d, e1)
-    basis = np.stack([e1, e2], axis=1)
-    p2 = origins @ basis
-    lo = tile_reduce(tiles, p2, np.minimum)
-    hi = tile_reduce(tiles, p2, np.maximum)
     centers = b.center[sel]
-    c2 = centers @ basis
-    gap = np.maximum(0.0, np.maximum(lo[:, None, :] - c2[None], c2[None] - hi[:, None, :]))
-    dist = _origin_distance(tiles, origins, centers)
-    r = cull_radius(b, sel, dist, np.full((len(tiles), 1), dlen), rnd)
-    keep = (np.linalg.norm(gap, axis=2) <= r) | ~np.isfinite(r)
-    # behind: min over the tile of (origin - centre).d, and the nearest origin's distance
-    ahead = tile_reduce(tiles, origins @ d, np.minimum)[:, None] - (centers @ d)[None, :]
-    lo3, hi3 = tile_reduce(tiles, origins, np.minimum), tile_reduce(tiles, origins, np.maximum)
-    near = np.linalg.norm(np.maximum(0.0, np.maximum(lo3[:, None] - centers[None], centers[None] - hi3[:, None])), axis=2)
-    smin, smax = b.smin[sel], b.smax[sel]
+    dlen = rays.length
+    dist = rays.space.reach(centers)
+    r = cull_radius(b, sel, dist, np.full((len(rays.lead), 1), dlen), rnd)
     with np.errstate(all="ignore"):
+        keep = (rays.plane.gap2(centers @ rays.basis) <= r * r) | ~np.isfinite(r)
+        # behind: min over the tile of (origin - centre).d, and the nearest origin's distance
+        ahead = rays.lead[:, None] - (centers @ rays.unit)[None, :]
+        smin, smax = b.smin[sel], b.smax[sel]
         u = rnd.u + rnd.tiny / np.minimum(1.0, (smin * dlen) ** 2)
         mean2, spread2 = (smax**2 + smin**2) / 2, (smax**2 - smin**2) / 2
         ds_low = dlen * (mean2 * ahead - (spread2 + 64.0 * u * smax**2) * dist)  # computed D.S stays above
-        behind = (ds_low > 2.0**-6) & (near > r) & np.isfinite(r)
+        behind = (ds_low > 2.0**-6) & (rays.space.gap2(centers) > r * r) & np.isfinite(r)
     return keep & ~behind
-
-
-def _origin_distance(tiles: Tiles, origins: np.ndarray, centers: np.ndarray) -> np.ndarray:
-    """(tiles, shapes): an upper bound of |origin - centre| over each tile's origins."""
-    lo = tile_reduce(tiles, origins, np.minimum)
-    hi = tile_reduce(tiles, origins, np.maximum)
-    mid, half = (lo + hi) / 2, np.linalg.norm(hi - lo, axis=1) / 2
-    return np.linalg.norm(centers[None] - mid[:, None], axis=2) + half[:, None]
 
 
 def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray) -> Iterator[tuple[np.ndarray, np.ndarray]]:

@@ -16,7 +16,7 @@ import numpy as np
 from .arith import Arith
 from .camera import camera_rays
 from .cull import (PAIR_CHUNK, Bounds, Rounding, cone_keep, depth_floor, grid_cones, make_tiles, pairs, parallel_keep,
-                   screen_tiles, shape_blocks, shape_bounds, tile_cones, tile_reduce)
+                   parallel_rays, screen_tiles, shape_blocks, shape_bounds, tile_boxes, tile_cones, tile_reduce)
 from .frame import Frame
 from .lighting import Recorder, diffuse
 from .lights import POINT, Light, lights_from_scene
@@ -181,7 +181,7 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
     blocks = list(shape_blocks(len(shapes), len(tiles), order))
     for done, sel in enumerate(blocks):
         if options.cull:
-            keep = cone_keep(tiles, cones, apex, None, bounds, sel, rnd)
+            keep = cone_keep(cones, apex, None, bounds, sel, rnd)
             # depth: a shape whose every hit is farther than a pixel's nearest so far cannot win it
             reached = near.sqd.copy() if near.hits else None
             if reached is not None:
@@ -250,20 +250,27 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
         if light.kind == POINT:
             apex = _f64(light.location)[0]
             cones = tile_cones(tiles, _f64(direction)[tiles.order])
+            boxes = tile_boxes(tiles, org)
+        else:
+            bundle = parallel_rays(tiles, _f64(direction)[0], org)
     per_shape = None
     if light.kind != POINT:  # one direction for every shadow ray: its normal-space terms per shape
         _, D_shape = to_object(ar, shapes, None, direction)
         per_shape = D_shape, direction_term(ar, shapes, D_shape)
     for sel in shape_blocks(len(shapes), len(tiles)):
+        open_ = None
         if not options.cull:
             keep = np.ones((len(tiles), len(sel)), bool)
-        elif light.kind == POINT:
-            keep = cone_keep(tiles, cones, apex, org, bounds, sel, rnd)
         else:
-            keep = parallel_keep(tiles, _f64(direction)[0], org, bounds, sel, rnd)
+            keep = (cone_keep(cones, apex, boxes, bounds, sel, rnd) if light.kind == POINT
+                    else parallel_keep(bundle, bounds, sel, rnd))
+            if blocked.any():  # a ray already blocked needs no more tests
+                open_ = ~blocked
+                keep &= tile_reduce(tiles, open_[tiles.order], np.logical_or)[:, None]
+
         def test(batch):
             pos, slot = batch
-            other = slot != own[pos]
+            other = slot != own[pos] if open_ is None else (slot != own[pos]) & open_[pos]
             pos, slot = pos[other], slot[other]
             s = shapes.take(slot)
             if per_shape is None:

@@ -225,28 +225,37 @@ def depth_floor(b: Bounds, apex: np.ndarray, dmin: float, rnd: Rounding) -> np.n
 
 @dataclass(frozen=True)
 class Boxes:
-    """Per tile, the bounding box of some points (e.g. its rays' origins): (tiles, k) arrays."""
+    """Per tile, the bounding box of some points (e.g. its rays' origins): (tiles, k) arrays.
+
+    Queries take points (n, k) and return (tiles, n) for every tile and point, or (n,)
+    when ``tiles`` names one tile per point.
+    """
 
     lo: np.ndarray
     hi: np.ndarray
 
-    def gap2(self, pts: np.ndarray) -> np.ndarray:
-        """(tiles, points): squared distance from each point to each box (0 inside)."""
-        total = np.zeros((len(self.lo), len(pts)))
+    def _sides(self, tiles: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        return (self.lo[:, None], self.hi[:, None]) if tiles is None else (self.lo[tiles], self.hi[tiles])
+
+    def gap2(self, pts: np.ndarray, tiles: np.ndarray | None = None) -> np.ndarray:
+        """Squared distance from the points to the boxes (0 inside)."""
+        lo, hi = self._sides(tiles)
+        total = 0.0
         for k in range(pts.shape[1]):
-            g = np.maximum(self.lo[:, k, None] - pts[None, :, k], pts[None, :, k] - self.hi[:, k, None])
+            g = np.maximum(lo[..., k] - pts[..., k], pts[..., k] - hi[..., k])
             np.maximum(g, 0.0, out=g)
-            total += g * g
+            total = total + g * g
         return total
 
-    def reach(self, pts: np.ndarray) -> np.ndarray:
-        """(tiles, points): an upper bound of the distance from each point to any box point."""
-        mid, half = (self.lo + self.hi) / 2, np.linalg.norm(self.hi - self.lo, axis=1) / 2
-        total = np.zeros((len(self.lo), len(pts)))
+    def reach(self, pts: np.ndarray, tiles: np.ndarray | None = None) -> np.ndarray:
+        """An upper bound of the distance from the points to any point of the boxes."""
+        lo, hi = self._sides(tiles)
+        mid, half = (lo + hi) / 2, np.linalg.norm(hi - lo, axis=-1) / 2
+        total = 0.0
         for k in range(pts.shape[1]):
-            g = pts[None, :, k] - mid[:, k, None]
-            total += g * g
-        return np.sqrt(total) * (1.0 + _SLACK) + half[:, None]
+            g = pts[..., k] - mid[..., k]
+            total = total + g * g
+        return np.sqrt(total) * (1.0 + _SLACK) + half
 
 
 def tile_boxes(tiles: Tiles, points: np.ndarray) -> Boxes:
@@ -282,22 +291,32 @@ def parallel_keep(rays: ParallelRays, b: Bounds, sel: np.ndarray, rnd: Rounding)
     A shape is skipped when it is off every ray line (as in :func:`cone_keep`), or when it
     lies behind every origin: then the computed b = 2 D.S is positive and c2 too, so
     ``sqrt(b*b - a2*c2) <= b`` (sqrt(fl(b*b)) = |b| in round-to-nearest) and neither root
-    is positive.
+    is positive. First every tile is tested with one radius per shape (from a distance
+    bound over all origins), then the remaining pairs with their tile's own bounds; each
+    test alone is sound, so skipping on either is.
     """
     centers = b.center[sel]
-    dlen = rays.length
-    dist = rays.space.reach(centers)
-    r = cull_radius(b, sel, dist, np.full((len(rays.lead), 1), dlen), rnd)
+    flat = centers @ rays.basis
+    dlen = np.array([[rays.length]])
+    whole = Boxes(rays.space.lo.min(axis=0, keepdims=True), rays.space.hi.max(axis=0, keepdims=True))
     with np.errstate(all="ignore"):
-        keep = (rays.plane.gap2(centers @ rays.basis) <= r * r) | ~np.isfinite(r)
+        r = cull_radius(b, sel, whole.reach(centers), dlen, rnd)
+        keep = (rays.plane.gap2(flat) <= r * r) | ~np.isfinite(r)
+        ti, si = np.nonzero(keep)
+        shape = sel[si]
+        dist = rays.space.reach(centers[si], ti)
+        r = cull_radius(b, shape, dist, rays.length, rnd)
+        near = (rays.plane.gap2(flat[si], ti) <= r * r) | ~np.isfinite(r)
         # behind: min over the tile of (origin - centre).d, and the nearest origin's distance
-        ahead = rays.lead[:, None] - (centers @ rays.unit)[None, :]
-        smin, smax = b.smin[sel], b.smax[sel]
-        u = rnd.u + rnd.tiny / np.minimum(1.0, (smin * dlen) ** 2)
+        ahead = rays.lead[ti] - centers[si] @ rays.unit
+        smin, smax = b.smin[shape], b.smax[shape]
+        u = rnd.u + rnd.tiny / np.minimum(1.0, (smin * rays.length) ** 2)
         mean2, spread2 = (smax**2 + smin**2) / 2, (smax**2 - smin**2) / 2
-        ds_low = dlen * (mean2 * ahead - (spread2 + 64.0 * u * smax**2) * dist)  # computed D.S stays above
-        behind = (ds_low > 2.0**-6) & (rays.space.gap2(centers) > r * r) & np.isfinite(r)
-    return keep & ~behind
+        ds_low = rays.length * (mean2 * ahead - (spread2 + 64.0 * u * smax**2) * dist)  # computed D.S stays above
+        behind = (ds_low > 2.0**-6) & (rays.space.gap2(centers[si], ti) > r * r) & np.isfinite(r)
+    drop = ~near | behind
+    keep[ti[drop], si[drop]] = False
+    return keep
 
 
 def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray) -> Iterator[tuple[np.ndarray, np.ndarray]]:

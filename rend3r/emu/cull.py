@@ -319,8 +319,9 @@ def parallel_keep(rays: ParallelRays, b: Bounds, sel: np.ndarray, rnd: Rounding)
     return keep
 
 
-def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-    """(active position, shape position) pairs of the kept (tile, shape) cells, in batches."""
+def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray) -> Iterator[tuple[np.ndarray, np.ndarray, bool]]:
+    """(active position, shape position) pairs of the kept (tile, shape) cells, in batches,
+    and whether a batch's positions are distinct (no tile in it twice)."""
     ti, si = np.nonzero(keep)
     counts = tiles.count[ti]
     ends = np.cumsum(counts)
@@ -331,7 +332,8 @@ def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray) -> Iterator[tuple[np.
         c = counts[lo:hi]
         total = int(c.sum())
         first = np.repeat(tiles.start[ti[lo:hi]] - np.concatenate(([0], np.cumsum(c)[:-1])), c)
-        yield tiles.order[first + np.arange(total)], np.repeat(sel[si[lo:hi]], c)
+        distinct = bool((np.diff(ti[lo:hi]) > 0).all())  # cells come tile by tile
+        yield tiles.order[first + np.arange(total)], np.repeat(sel[si[lo:hi]], c), distinct
         lo = hi
 
 

@@ -51,8 +51,18 @@ class _Nearest:
         self.t = np.full(n, np.nan, dtype=dtype)  # the winner's t
         self.hits = 0  # hits merged so far
 
-    def update(self, pix: np.ndarray, slot: np.ndarray, sqd: np.ndarray, t: np.ndarray | None = None) -> None:
+    def update(self, pix: np.ndarray, slot: np.ndarray, sqd: np.ndarray, t: np.ndarray | None = None,
+               distinct: bool = False) -> None:
+        """Merge hits; ``distinct``: no pixel occurs twice in ``pix`` (a cheaper merge)."""
         self.hits += len(pix)
+        if distinct:
+            now = self.sqd[pix]
+            better = (sqd < now) | ((sqd == now) & (slot < self.slot[pix]))
+            won = pix[better]
+            self.sqd[won], self.slot[won] = sqd[better], slot[better]
+            if t is not None:
+                self.t[won] = t[better]
+            return
         before = self.sqd[pix]
         np.minimum.at(self.sqd, pix, sqd)
         now = self.sqd[pix]
@@ -105,9 +115,10 @@ def render_frame(
         point, normal = (tuple(np.concatenate([p[k][a] for p in parts]) if parts else empty[a] for a in range(3))
                          if k == 0 or lights else None for k in range(2))
         color, bad = shade_hits(ar, options, shapes, bounds, lights, hp, slot, point, normal, st, nan_pixel)
-        nan_pixel[hp[bad]] = True
-        hp, slot = hp[~bad], slot[~bad]
-        rgb[hp] = color[~bad]
+        if bad.any():
+            nan_pixel[hp[bad]] = True
+            hp, slot, color = hp[~bad], slot[~bad], color[~bad]
+        rgb[hp] = color
         depth[hp] = np.sqrt(near.sqd[hp].astype(np.float64))
         prov[hp] = shapes.index[slot]
         st.hits = len(hp)
@@ -190,7 +201,7 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
             keep, reached = np.ones((len(tiles), len(sel)), bool), None
 
         def test(batch):
-            pix, slot = batch
+            pix, slot, distinct = batch
             if reached is not None:
                 live = floor[slot] <= reached[pix]
                 pix, slot = pix[live], slot[live]
@@ -204,13 +215,13 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
             sol = solve(ar, s, _take(S_shape, slot), Dh, c2_shape[slot], rays.tmin, rays.tmax, a2)
             sqd = squared_distance(ar, dd[pix], sol.t)
             bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
-            return pix, slot, sqd, sol.t, sol.hit & ~bad, bad
+            return pix, slot, sqd, sol.t, sol.hit & ~bad, bad, distinct
 
-        for pix, slot, sqd, t, hit, bad in map(test, pairs(tiles, keep, sel)):
+        for pix, slot, sqd, t, hit, bad, distinct in map(test, pairs(tiles, keep, sel)):
             st.tests += len(pix)
             st.nan_tests += int(bad.sum())
             nan_pixel[pix[bad]] = True
-            near.update(pix[hit], slot[hit], sqd[hit], t[hit])
+            near.update(pix[hit], slot[hit], sqd[hit], t[hit], distinct)
         if progress is not None:
             progress((done + 1) / len(blocks))
     st.skipped += n_pix * len(shapes) - st.tests
@@ -269,7 +280,7 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
                 keep &= tile_reduce(tiles, open_[tiles.order], np.logical_or)[:, None]
 
         def test(batch):
-            pos, slot = batch
+            pos, slot, _ = batch
             other = slot != own[pos] if open_ is None else (slot != own[pos]) & open_[pos]
             pos, slot = pos[other], slot[other]
             s = shapes.take(slot)

@@ -32,7 +32,7 @@ class Rays:
     tmin: np.ndarray
     tmax: np.ndarray
     #: When the directions are exactly (x[column], y[row], z): (x, y, z); else None.
-    grid: tuple[np.ndarray, np.ndarray, float] | None = None
+    grid: Vec | None = None
 
 
 def camera_rays(scene: Scene, options: EmuOptions, arith: Arith) -> Rays:
@@ -64,7 +64,7 @@ def _device_rays(origin: Vec, width: int, height: int, arith: Arith) -> Rays:
     dy = np.broadcast_to(ys[:, None], (height, width)).ravel()
     z = arith.from_bits(DEVICE_Z)
     dz = np.full(width * height, z, dtype=arith.dtype)
-    return Rays(origin, (dx, dy, dz), arith.const(0.0), arith.const(np.inf), (xs, ys, float(z)))
+    return Rays(origin, (dx, dy, dz), arith.const(0.0), arith.const(np.inf), (xs, ys, z))
 
 
 def camera_value(scene: Scene, name: str, arith: Arith, default: float) -> np.ndarray:
@@ -113,5 +113,5 @@ def _spec_rays(scene: Scene, origin: Vec, width: int, height: int, arith: Arith)
     direction = cam if q is None else rotate(arith, q, cam)
     far = arith.from_bits(scene.camera_bits("fclip"))
     tmax = arith.const(np.inf) if float(far) == 0.0 else arith.div(far, near)
-    grid = (cx, cy, float(arith.neg(near))) if q is None else None
+    grid = (cx, cy, arith.neg(near)) if q is None else None
     return Rays(origin, direction, arith.const(1.0), tmax, grid)

@@ -146,7 +146,7 @@ def tile_cones(tiles: Tiles, dirs: np.ndarray) -> Cones:
     return Cones(axis, half, tile_reduce(tiles, length, np.minimum)[:, None])
 
 
-def grid_cones(x: np.ndarray, y: np.ndarray, z: float, tiles: Tiles, width: int) -> Cones:
+def grid_cones(x: np.ndarray, y: np.ndarray, z: np.ndarray, tiles: Tiles, width: int) -> Cones:
     """:func:`tile_cones` of screen tiles whose directions are the grid (x[column], y[row], z).
 
     A tile's directions lie in the rectangle spanned by its x and y ranges at height z, so
@@ -155,7 +155,7 @@ def grid_cones(x: np.ndarray, y: np.ndarray, z: float, tiles: Tiles, width: int)
     """
     first = tiles.order[tiles.start]  # each tile's first (top-left) pixel
     c0, r0 = first % width, first // width
-    xs, ys = np.asarray(x, np.float64), np.asarray(y, np.float64)
+    xs, ys, z = np.asarray(x, np.float64), np.asarray(y, np.float64), float(z)
     def span(v: np.ndarray, lo: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         blocks = np.pad(v, (0, -len(v) % TILE), mode="edge").reshape(-1, TILE)
         return blocks.min(axis=1)[lo // TILE], blocks.max(axis=1)[lo // TILE]

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from time import perf_counter
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 
 from .arith import Arith
-from .camera import camera_rays
+from .camera import Rays, camera_rays
 from .cull import (PAIR_CHUNK, Bounds, Rounding, cone_keep, depth_floor, grid_cones, make_tiles, pairs, parallel_keep,
                    parallel_rays, screen_tiles, shape_blocks, shape_bounds, tile_boxes, tile_cones, tile_reduce)
 from .frame import Frame
@@ -91,7 +91,7 @@ def render_frame(
     nan_pixel = np.zeros(n_pix, dtype=bool)
     if len(shapes):
         bounds = shape_bounds(shapes)
-        dd = dot(ar, rays.direction, rays.direction)
+        dd = _squared_lengths(ar, rays)
         near, tables, S_shape = _primary(ar, options, rays, dd, shapes, bounds, st, nan_pixel, progress)
         hp = np.nonzero(near.slot != _NONE)[0]
         slot = near.slot[hp]
@@ -148,25 +148,54 @@ class _DirectionTables:
         return (c[0][row], c[1][row], c[2][row]), c[3][row]
 
 
-def _direction_tables(ar: Arith, shapes: Shapes, direction: Vec) -> _DirectionTables | None:
+def _direction_tables(ar: Arith, shapes: Shapes, rays: Rays) -> _DirectionTables | None:
     """The direction tables, or None when classes * pixels is too large.
 
     A pair then reads its class's row instead of repeating the rotation: bit-identical,
     since it is the same sequence of operations on the same values.
     """
     first, cls = transform_classes(shapes)
-    n = len(direction[0])
+    n = len(rays.direction[0])
     if len(first) * n > _CLASS_TABLE_LIMIT:
         return None
-    def row(job):
-        rep, lo, hi = job
+    columns = [np.empty(len(first) * n, ar.dtype) for _ in range(4)]
+    for k, rep in enumerate(first):
         s = shapes.take(np.array([rep]))
-        _, Dh = to_object(ar, s, None, tuple(c[lo:hi] for c in direction))
-        return (*Dh, direction_term(ar, s, Dh))
+        for lo, hi, shape, d in _direction_chunks(rays):
+            _, Dh = to_object(ar, s, None, d)
+            for column, value in zip(columns, (*Dh, direction_term(ar, s, Dh))):
+                column[k * n + lo:k * n + hi].reshape(shape)[...] = value
+    return _DirectionTables(first, cls, len(first) == 1, n, columns)
 
-    jobs = [(rep, lo, min(n, lo + PAIR_CHUNK)) for rep in first for lo in range(0, n, PAIR_CHUNK)]
-    parts = [row(job) for job in jobs]
-    return _DirectionTables(first, cls, len(first) == 1, n, [np.concatenate([p[k] for p in parts]) for k in range(4)])
+
+def _squared_lengths(ar: Arith, rays: Rays) -> np.ndarray:
+    """|d|^2 of every primary ray (from a grid camera, products once per column and row)."""
+    if rays.grid is None:
+        return dot(ar, rays.direction, rays.direction)
+    x, y, z = rays.grid
+    d = (x[None, :], y[:, None], z)
+    return np.broadcast_to(dot(ar, d, d), (len(y), len(x))).ravel()
+
+
+def _direction_chunks(rays: Rays) -> Iterator[tuple[int, int, tuple[int, ...], Vec]]:
+    """The primary directions in cache-sized pieces: (first pixel, end, shape, directions).
+
+    From a grid camera the pieces are rows, with directions as (1, w), (rows, 1) and 0-d
+    arrays: products of one coordinate are then computed once per column or row, and only
+    the sums that mix them per pixel (the same operations on the same values).
+    """
+    n = len(rays.direction[0])
+    if rays.grid is None:
+        for lo in range(0, n, PAIR_CHUNK):
+            hi = min(n, lo + PAIR_CHUNK)
+            yield lo, hi, (hi - lo,), tuple(c[lo:hi] for c in rays.direction)
+        return
+    x, y, z = rays.grid
+    w = len(x)
+    step = max(1, PAIR_CHUNK // w)
+    for r in range(0, len(y), step):
+        rows = y[r:r + step]
+        yield r * w, (r + len(rows)) * w, (len(rows), w), (x[None, :], rows[:, None], z)
 
 
 def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: Bounds,
@@ -178,7 +207,7 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
     near = _Nearest(n_pix, ar.dtype)
     S_shape, _ = to_object(ar, shapes, rays.origin, None)
     c2_shape = origin_term(ar, shapes, S_shape)
-    tables = _direction_tables(ar, shapes, rays.direction)
+    tables = _direction_tables(ar, shapes, rays)
     form = uniform_form(shapes)
     tiles = screen_tiles(n_pix, options.width)
     rnd = Rounding.of(ar)

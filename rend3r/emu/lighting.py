@@ -54,8 +54,8 @@ def diffuse(
     bad = ~(np.isfinite(point[0]) & np.isfinite(point[1]) & np.isfinite(point[2]))
     if not lights:
         return base, bad
-    channels = [((base >> shift) & top).astype(np.float64) for shift, top in _CHANNELS]
-    acc = [np.zeros(len(base)) for _ in _CHANNELS]
+    channels = [(base >> shift) & top for shift, top in _CHANNELS]
+    acc: list[np.ndarray | None] = [None] * len(_CHANNELS)
     nn = ar.sqrt(dot(ar, normal, normal))
     for light in lights:
         tag = f"L{light.index}."
@@ -75,23 +75,30 @@ def diffuse(
             rec(tag + name, value)
         finite = np.isfinite(cos) & np.isfinite(f)
         bad |= ~finite
-        factor = np.broadcast_to(np.asarray(f, np.float64), bad.shape)
+        factor = f
         if intensity_fixed:
-            k = fixed_intensity(np.where(finite, factor, 0.0))
+            k = fixed_intensity(np.where(finite, f, 0.0))
             rec(tag + "fixed", k)
             factor = k / FIXED_SCALE
         on = finite & ~bad & (cos > 0)
         if intensity_fixed:
             on &= factor > 0  # a wrapped, negative converter output is black
-        lit = np.nonzero(on)[0]
         if occluded is not None:
-            shadow = occluded(light, lit, tuple(c[lit] if np.ndim(c) else c for c in l_vec))
+            lit = np.flatnonzero(on)
+            shadow = occluded(light, lit, tuple(np.take(c, lit) if np.ndim(c) else c for c in l_vec))
             rec(tag + "shadow", shadow)
-            lit = lit[~shadow]
+            on[lit[shadow]] = False
         # unlit points weigh 0: adding 0 * channel * scale (= +0) leaves their sums as they are
         weight = np.zeros(len(base))
-        weight[lit] = factor[lit]
-        for a, ch, (shift, top) in zip(acc, channels, _CHANNELS):
-            a += weight * ch * (((light.color >> shift) & top) / top)
-    r, g, b = (np.clip(np.floor(a + 0.5), 0, top).astype(np.uint16) for a, (_, top) in zip(acc, _CHANNELS))
-    return (r << 11) | (g << 5) | b, bad
+        np.copyto(weight, factor, where=on)
+        for c, (ch, (shift, top)) in enumerate(zip(channels, _CHANNELS)):
+            term = np.multiply(weight, ch)  # float64: exact, as the channel values are small integers
+            term *= ((light.color >> shift) & top) / top
+            acc[c] = term if acc[c] is None else np.add(acc[c], term, out=acc[c])
+    out = np.zeros(len(base), np.uint16)
+    for a, (shift, top) in zip(acc, _CHANNELS):
+        a += 0.5
+        np.floor(a, out=a)
+        np.clip(a, 0, top, out=a)
+        out |= a.astype(np.uint16) << shift
+    return out, bad

@@ -42,6 +42,13 @@ def _take(v: Vec, idx: np.ndarray) -> Vec:
 
 
 
+def _pick(mask: np.ndarray, *arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Each array's entries where ``mask`` holds: one index pass, then gathers (boolean
+    indexing is several times slower on irregular masks)."""
+    idx = np.flatnonzero(mask)
+    return tuple(np.take(a, idx) for a in arrays)
+
+
 class _Nearest:
     """Running nearest hit per pixel: smallest squared distance, ties to the lower index."""
 
@@ -49,29 +56,39 @@ class _Nearest:
         self.sqd = np.full(n, np.inf, dtype=dtype)
         self.slot = np.full(n, _NONE, dtype=np.int64)
         self.t = np.full(n, np.nan, dtype=dtype)  # the winner's t
-        self.hits = 0  # hits merged so far
+        self.any = False  # whether any hit was merged
 
     def update(self, pix: np.ndarray, slot: np.ndarray, sqd: np.ndarray, t: np.ndarray | None = None,
-               distinct: bool = False) -> None:
-        """Merge hits; ``distinct``: no pixel occurs twice in ``pix`` (a cheaper merge)."""
-        self.hits += len(pix)
+               distinct: bool = False, hit: np.ndarray | None = None) -> None:
+        """Merge the pairs (those where ``hit`` holds, if given) as hits.
+
+        ``distinct``: no pixel occurs twice in ``pix``, which allows a cheaper merge.
+        """
+        extra = () if t is None else (t,)
         if distinct:
-            now = self.sqd[pix]
-            better = (sqd < now) | ((sqd == now) & (slot < self.slot[pix]))
-            won = pix[better]
-            self.sqd[won], self.slot[won] = sqd[better], slot[better]
+            now = np.take(self.sqd, pix)
+            better = (sqd < now) | ((sqd == now) & (slot < np.take(self.slot, pix)))
+            if hit is not None:
+                better &= hit
+            won, sqd, slot, *extra = _pick(better, pix, sqd, slot, *extra)
+            self.sqd[won], self.slot[won] = sqd, slot
             if t is not None:
-                self.t[won] = t[better]
+                self.t[won] = extra[0]
+            self.any |= len(won) > 0
             return
-        before = self.sqd[pix]
+        if hit is not None:
+            pix, slot, sqd, *extra = _pick(hit, pix, slot, sqd, *extra)
+        self.any |= len(pix) > 0
+        before = np.take(self.sqd, pix)
         np.minimum.at(self.sqd, pix, sqd)
-        now = self.sqd[pix]
-        self.slot[pix[now < before]] = _NONE
+        now = np.take(self.sqd, pix)
+        self.slot[_pick(now < before, pix)[0]] = _NONE
         tie = sqd == now
-        np.minimum.at(self.slot, pix[tie], slot[tie])
+        np.minimum.at(self.slot, *_pick(tie, pix, slot))
         if t is not None:
-            won = tie & (self.slot[pix] == slot)
-            self.t[pix[won]] = t[won]
+            won = tie & (np.take(self.slot, pix) == slot)
+            won_pix, won_t = _pick(won, pix, extra[0])
+            self.t[won_pix] = won_t
 
 
 def render_frame(
@@ -223,7 +240,7 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
         if options.cull:
             keep = cone_keep(cones, apex, None, bounds, sel, rnd)
             # depth: a shape whose every hit is farther than a pixel's nearest so far cannot win it
-            reached = near.sqd.copy() if near.hits else None
+            reached = near.sqd.copy() if near.any else None
             if reached is not None:
                 keep &= floor[sel][None, :] <= tile_reduce(tiles, reached[tiles.order], np.maximum)[:, None]
         else:
@@ -232,8 +249,7 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
         def test(batch):
             pix, slot, distinct = batch
             if reached is not None:
-                live = floor[slot] <= reached[pix]
-                pix, slot = pix[live], slot[live]
+                pix, slot = _pick(np.take(floor, slot) <= np.take(reached, pix), pix, slot)
             if tables is None:
                 s = shapes.take(slot)
                 _, Dh = to_object(ar, s, None, _take(rays.direction, pix))
@@ -249,8 +265,8 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
         for pix, slot, sqd, t, hit, bad, distinct in map(test, pairs(tiles, keep, sel)):
             st.tests += len(pix)
             st.nan_tests += int(bad.sum())
-            nan_pixel[pix[bad]] = True
-            near.update(pix[hit], slot[hit], sqd[hit], t[hit], distinct)
+            nan_pixel[_pick(bad, pix)[0]] = True
+            near.update(pix, slot, sqd, t, distinct, hit)
         if progress is not None:
             progress((done + 1) / len(blocks))
     st.skipped += n_pix * len(shapes) - st.tests
@@ -311,7 +327,7 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
         def test(batch):
             pos, slot, _ = batch
             other = slot != own[pos] if open_ is None else (slot != own[pos]) & open_[pos]
-            pos, slot = pos[other], slot[other]
+            pos, slot = _pick(other, pos, slot)
             s = shapes.take(slot)
             if per_shape is None:
                 S, D = to_object(ar, s, _take(origin, pos), _take(direction, pos))
@@ -325,7 +341,7 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
         for pos, hit, bad in map(test, pairs(tiles, keep, sel)):
             st.tests += len(pos)
             st.nan_tests += int(bad.sum())
-            nan_pixel[pix[pos[bad]]] = True
-            blocked[pos[hit]] = True
+            nan_pixel[pix[_pick(bad, pos)[0]]] = True
+            blocked[_pick(hit, pos)[0]] = True
     st.skipped += n * (len(shapes) - 1) - (st.tests - before)
     return blocked

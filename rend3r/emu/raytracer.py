@@ -42,6 +42,18 @@ def _take(v: Vec, idx: np.ndarray) -> Vec:
 
 
 
+def _rows(idx: np.ndarray) -> np.ndarray | slice:
+    """Sorted, distinct indices as a slice when they form one run (views, not gathers)."""
+    if len(idx) and idx[-1] - idx[0] + 1 == len(idx):
+        return slice(int(idx[0]), int(idx[-1]) + 1)
+    return idx
+
+
+def _one(slots: np.ndarray) -> np.ndarray:
+    """Shape positions, shortened to one entry when all are the same (then values broadcast)."""
+    return slots[:1] if len(slots) and (slots == slots[0]).all() else slots
+
+
 def _pick(mask: np.ndarray, *arrays: np.ndarray) -> tuple[np.ndarray, ...]:
     """Each array's entries where ``mask`` holds: one index pass, then gathers (boolean
     indexing is several times slower on irregular masks)."""
@@ -110,13 +122,13 @@ def render_frame(
         bounds = shape_bounds(shapes)
         dd = _squared_lengths(ar, rays)
         near, tables, S_shape = _primary(ar, options, rays, dd, shapes, bounds, st, nan_pixel, progress)
-        hp = np.nonzero(near.slot != _NONE)[0]
+        hp = np.flatnonzero(near.slot != _NONE)
         slot = near.slot[hp]
 
         def hit_surface(job):
             lo, hi = job
-            px, sl = hp[lo:hi], slot[lo:hi]
-            D = _take(rays.direction, px)
+            px, sl = _rows(hp[lo:hi]), _one(slot[lo:hi])
+            D = tuple(c[px] for c in rays.direction)
             if not lights:  # unlit: the point alone (for NaN checks), no normal
                 return surface(ar, None, None, None, near.t[px], rays.origin, D, normals=False)
             if tables is None:
@@ -135,10 +147,11 @@ def render_frame(
         if bad.any():
             nan_pixel[hp[bad]] = True
             hp, slot, color = hp[~bad], slot[~bad], color[~bad]
+        st.hits = len(hp)
+        hp = _rows(hp)
         rgb[hp] = color
         depth[hp] = np.sqrt(near.sqd[hp].astype(np.float64))
         prov[hp] = shapes.index[slot]
-        st.hits = len(hp)
     st.nan_rays = int(nan_pixel.sum())
     st.seconds = perf_counter() - start
     frame = Frame(number, rgb.reshape(h, w), depth.reshape(h, w), prov.reshape(h, w))
@@ -159,8 +172,11 @@ class _DirectionTables:
     n: int  # pixels
     columns: list[np.ndarray]
 
-    def read(self, slot: np.ndarray, pix: np.ndarray) -> tuple[Vec, np.ndarray]:
-        row = pix if self.single else self.cls[slot] * self.n + pix
+    def read(self, slot: np.ndarray, pix: np.ndarray | slice) -> tuple[Vec, np.ndarray]:
+        if self.single:
+            row = pix
+        else:
+            row = self.cls[slot] * self.n + (np.arange(pix.start, pix.stop) if isinstance(pix, slice) else pix)
         c = self.columns
         return (c[0][row], c[1][row], c[2][row]), c[3][row]
 

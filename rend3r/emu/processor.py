@@ -49,17 +49,19 @@ def execute(
     frames: int | None = None,
     on_nf: RenderHook | None = None,
     scene: Scene | None = None,
+    decoded: dict[int, tuple[object, int]] | None = None,
 ) -> Execution:
     """Run ``words`` until ``er``, the end, or ``frames`` frames; call ``on_nf`` at each nf.
 
     Raises Rend3rError for an unknown opcode or trailing SE (with its address), for a
     looping program without a ``frames`` bound, and for a loop that renders nothing.
+    ``decoded`` caches decoded words by address (pass the same dict to run ``words`` again).
     """
     if frames is not None and frames < 1:
         raise Rend3rError(f"--frames must be at least 1, not {frames}")
     scene = scene if scene is not None else Scene()
     table = Table.TRIANGLE if options.mode == "raster" else Table.SHAPE
-    decoded: dict[int, tuple[object, int]] = {}
+    decoded = {} if decoded is None else decoded  # address -> (instruction, size); callers may share it
     pc = count = executed = 0
     frames_at_last_lr = -1
     while pc < len(words):

@@ -7,8 +7,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ..errors import Rend3rError
 from .frame import Frame
+from .memory import reuse_freed_memory
 from .options import EmuOptions
 from .processor import execute
 from .scene import Scene
@@ -41,10 +41,8 @@ def _renderer(options: EmuOptions):
 
         return hybrid_frame
     if options.mode == "raster":
-        try:
-            from .raster import render_frame  # provided by the rasterizer
-        except ImportError:
-            raise Rend3rError("--mode raster is not available yet: the rasterizer is not part of this build") from None
+        from .raster import render_frame
+
         return render_frame
     from .raytracer import render_frame
 
@@ -69,7 +67,9 @@ def run_program(
     """
     options = options or EmuOptions()
     words = list(words)
-    execute(words, options, frames)  # validation pass
+    decoded: dict = {}  # shared by both passes: each word is decoded once
+    execute(words, options, frames, decoded=decoded)  # validation pass
+    reuse_freed_memory()
     render = _renderer(options)
     result = RunResult()
 
@@ -92,6 +92,6 @@ def run_program(
         if on_frame is not None:
             on_frame(frame)
 
-    ex = execute(words, options, frames, on_nf)
+    ex = execute(words, options, frames, on_nf, decoded=decoded)
     result.stats.instructions, result.stats.halt = ex.instructions, ex.halt
     return result

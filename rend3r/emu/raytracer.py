@@ -78,10 +78,13 @@ class _Nearest:
         """
         extra = () if t is None else (t,)
         if distinct:
-            now = np.take(self.sqd, pix)
-            better = (sqd < now) | ((sqd == now) & (slot < np.take(self.slot, pix)))
-            if hit is not None:
-                better &= hit
+            if not self.any:  # every hit beats no hit
+                better = np.ones(len(pix), bool) if hit is None else hit
+            else:
+                now = np.take(self.sqd, pix)
+                better = (sqd < now) | ((sqd == now) & (slot < np.take(self.slot, pix)))
+                if hit is not None:
+                    better &= hit
             won, sqd, slot, *extra = _pick(better, pix, sqd, slot, *extra)
             self.sqd[won], self.slot[won] = sqd, slot
             if t is not None:
@@ -273,7 +276,8 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
             else:
                 s = form or Form(shapes.zsign[slot])
                 Dh, a2 = tables.read(slot, pix)
-            sol = solve(ar, s, _take(S_shape, slot), Dh, c2_shape[slot], rays.tmin, rays.tmax, a2)
+            one = _one(slot)  # a batch on one shape: its values broadcast
+            sol = solve(ar, s, _take(S_shape, one), Dh, c2_shape[one], rays.tmin, rays.tmax, a2)
             sqd = squared_distance(ar, dd[pix], sol.t)
             bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
             return pix, slot, sqd, sol.t, sol.hit & ~bad, bad, distinct

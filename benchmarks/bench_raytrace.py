@@ -3,11 +3,12 @@
 Workloads: 1, 16, 256, 4096 spheres with 0 and 1 directional lights at 512x384. Spheres
 stand in a G x G wall of columns K deep (4096 = 16 x 16 x 16), sized so that the front
 layer stays inside float16's range (|D||S| < 128 in normal space; see docs/emulator.md).
-Prints the median wall time per frame over --runs renders, the device estimate
-(shapes + 205) * (lights + 1) * pixels cycles at 100 MHz, and device/emulator ratios.
+Prints the median wall time per frame over --runs renders (after one warm-up render), the
+device estimate (shapes + 205) * (lights + 1) * pixels cycles at 100 MHz, and
+device/emulator ratios; first, a calibration figure of the machine's numpy speed.
 Targets: fp16 faster than the device on every row; fp32 at least 10x faster.
 
-    python benchmarks/bench_raytrace.py [--runs 3] [--shapes 1 16 256 4096] [--precision fp16 fp32]
+    python benchmarks/bench_raytrace.py [--runs 5] [--shapes 1 16 256 4096] [--precision fp16 fp32]
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
+
+import numpy as np
 
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.run import run_program
@@ -61,6 +64,8 @@ def workload(shapes: int, lights: int) -> list[int]:
 
 
 def measure(words: list[int], precision: str, runs: int) -> tuple[float, object]:
+    """Median wall time of ``runs`` renders after one untimed warm-up render."""
+    run_program(words, EmuOptions(precision=precision))
     times, stats = [], None
     for _ in range(runs):
         start = time.perf_counter()
@@ -70,14 +75,27 @@ def measure(words: list[int], precision: str, runs: int) -> tuple[float, object]
     return statistics.median(times), stats
 
 
+def _calibration_us() -> float:
+    """A fixed numpy workload, to compare machines and moments (shared machines drift)."""
+    a = np.linspace(1.0, 2.0, 1 << 16, dtype=np.float32)
+    times = []
+    for _ in range(7):
+        start = time.perf_counter()
+        for _ in range(1000):
+            np.multiply(a, a)
+        times.append((time.perf_counter() - start) / 1000 * 1e6)
+    return statistics.median(times)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--runs", type=int, default=5)
     ap.add_argument("--shapes", type=int, nargs="+", default=[1, 16, 256, 4096], choices=sorted(LAYOUT))
     ap.add_argument("--lights", type=int, nargs="+", default=[0, 1], choices=[0, 1])
     ap.add_argument("--precision", nargs="+", default=["fp16", "fp32"], choices=["fp16", "fp32", "fp64"])
     args = ap.parse_args()
     pixels = 512 * 384
+    print(f"machine: a float32 multiply of 65,536 elements takes {_calibration_us():.1f} us (median of 7)")
     print(f"{'shapes':>6} {'lights':>6} {'prec':>5} {'emulator s':>11} {'device s':>9} {'device/emu':>10} "
           f"{'target':>7} {'tests':>11} {'skipped':>13} {'hits':>7} {'nan':>9}")
     for lights in args.lights:

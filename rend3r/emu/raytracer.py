@@ -49,9 +49,10 @@ def _rows(idx: np.ndarray) -> np.ndarray | slice:
     return idx
 
 
-def _one(slots: np.ndarray) -> np.ndarray:
-    """Shape positions, shortened to one entry when all are the same (then values broadcast)."""
-    return slots[:1] if len(slots) and (slots == slots[0]).all() else slots
+def _one(slots: np.ndarray) -> np.ndarray | int:
+    """Shape positions, or the one position when all are the same (its values then enter
+    as scalars, which broadcast)."""
+    return int(slots[0]) if len(slots) and (slots == slots[0]).all() else slots
 
 
 def _pick(mask: np.ndarray, *arrays: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -138,7 +139,7 @@ def render_frame(
                 s = shapes.take(sl)
                 _, Dh = to_object(ar, s, None, D)
             else:  # one transform class: its parameters broadcast, nothing to gather per hit
-                s = shapes.take(tables.first[:1] if tables.single else sl)
+                s = shapes.take(int(tables.first[0]) if tables.single else sl)
                 Dh, _ = tables.read(sl, px)
             return surface(ar, s, _take(S_shape, sl), Dh, near.t[px], rays.origin, D)
 
@@ -196,7 +197,7 @@ def _direction_tables(ar: Arith, shapes: Shapes, rays: Rays) -> _DirectionTables
         return None
     columns = [np.empty(len(first) * n, ar.dtype) for _ in range(4)]
     for k, rep in enumerate(first):
-        s = shapes.take(np.array([rep]))
+        s = shapes.take(int(rep))  # scalars: they broadcast cheaper than one-element arrays
         for lo, hi, shape, d in _direction_chunks(rays):
             _, Dh = to_object(ar, s, None, d)
             for column, value in zip(columns, (*Dh, direction_term(ar, s, Dh))):

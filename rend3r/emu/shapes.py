@@ -43,8 +43,9 @@ class Shapes:
     def __len__(self) -> int:
         return len(self.index)
 
-    def take(self, sel: np.ndarray) -> "Shapes":
-        """The shapes at positions ``sel`` (e.g. one entry per pixel-shape pair)."""
+    def take(self, sel: np.ndarray | int) -> "Shapes":
+        """The shapes at positions ``sel`` (e.g. one entry per pixel-shape pair; an int
+        gives scalar values)."""
         t = lambda a: a[sel]  # noqa: E731
         return Shapes(
             t(self.index), t(self.kind), tuple(map(t, self.loc)), tuple(map(t, self.rot)),

@@ -319,21 +319,35 @@ def parallel_keep(rays: ParallelRays, b: Bounds, sel: np.ndarray, rnd: Rounding)
     return keep
 
 
-def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray) -> Iterator[tuple[np.ndarray, np.ndarray, bool]]:
-    """(active position, shape position) pairs of the kept (tile, shape) cells, in batches,
-    and whether a batch's positions are distinct (no tile in it twice)."""
+def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray,
+          distinct: bool = False) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """(active position, shape position) pairs of the kept (tile, shape) cells, in batches.
+
+    ``distinct``: no batch holds a position twice. Cells then go by rank within their
+    tile (every tile's first cell, then every second cell, ...) and batches do not mix
+    ranks; otherwise they go tile by tile.
+    """
     ti, si = np.nonzero(keep)
+    if not len(ti):
+        return
+    bounds = np.array([len(ti)])
+    if distinct:
+        idx = np.arange(len(ti))
+        rank = idx - np.maximum.accumulate(np.where(np.r_[True, ti[1:] != ti[:-1]], idx, 0))
+        order = np.argsort(rank, kind="stable")
+        ti, si, rank = ti[order], si[order], rank[order]
+        bounds = np.r_[np.flatnonzero(rank[1:] != rank[:-1]) + 1, len(ti)]
     counts = tiles.count[ti]
     ends = np.cumsum(counts)
     lo = 0
     while lo < len(ti):
+        stop = int(bounds[np.searchsorted(bounds, lo, side="right")])
         hi = int(np.searchsorted(ends, (ends[lo - 1] if lo else 0) + PAIR_CHUNK, side="right"))
-        hi = max(hi, lo + 1)
+        hi = min(max(hi, lo + 1), stop)
         c = counts[lo:hi]
         total = int(c.sum())
         first = np.repeat(tiles.start[ti[lo:hi]] - np.concatenate(([0], np.cumsum(c)[:-1])), c)
-        distinct = bool((np.diff(ti[lo:hi]) > 0).all())  # cells come tile by tile
-        yield tiles.order[first + np.arange(total)], np.repeat(sel[si[lo:hi]], c), distinct
+        yield tiles.order[first + np.arange(total)], np.repeat(sel[si[lo:hi]], c)
         lo = hi
 
 

@@ -267,7 +267,7 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
             keep, reached = np.ones((len(tiles), len(sel)), bool), None
 
         def test(batch):
-            pix, slot, distinct = batch
+            pix, slot = batch
             if reached is not None:
                 pix, slot = _pick(np.take(floor, slot) <= np.take(reached, pix), pix, slot)
             if tables is None:
@@ -281,13 +281,13 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
             sol = solve(ar, s, _take(S_shape, one), Dh, c2_shape[one], rays.tmin, rays.tmax, a2)
             sqd = squared_distance(ar, dd[pix], sol.t)
             bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
-            return pix, slot, sqd, sol.t, sol.hit & ~bad, bad, distinct
+            return pix, slot, sqd, sol.t, sol.hit & ~bad, bad
 
-        for pix, slot, sqd, t, hit, bad, distinct in map(test, pairs(tiles, keep, sel)):
+        for pix, slot, sqd, t, hit, bad in map(test, pairs(tiles, keep, sel, distinct=True)):
             st.tests += len(pix)
             st.nan_tests += int(bad.sum())
             nan_pixel[_pick(bad, pix)[0]] = True
-            near.update(pix, slot, sqd, t, distinct, hit)
+            near.update(pix, slot, sqd, t, distinct=True, hit=hit)
         if progress is not None:
             progress((done + 1) / len(blocks))
     st.skipped += n_pix * len(shapes) - st.tests
@@ -346,7 +346,7 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
                 keep &= tile_reduce(tiles, open_[tiles.order], np.logical_or)[:, None]
 
         def test(batch):
-            pos, slot, _ = batch
+            pos, slot = batch
             other = slot != own[pos] if open_ is None else (slot != own[pos]) & open_[pos]
             pos, slot = _pick(other, pos, slot)
             s = shapes.take(slot)

@@ -22,6 +22,7 @@ from .arith import Arith
 from .shapes import SPHERE, Shapes
 
 TILE = 16  # pixels per tile side
+FINE = 8  # side of the finer tiles primary rays are culled in, inside TILE tiles
 PAIR_CHUNK = 1 << 16  # pixel-shape pairs per batch: temporaries stay cache-sized
 
 @dataclass(frozen=True)
@@ -52,28 +53,44 @@ class Tiles:
     start: np.ndarray  # per tile: offset into order
     count: np.ndarray  # per tile: number of active pixels
     of_pixel: np.ndarray  # per active pixel (in order): its tile number
+    size: int = TILE  # pixels per tile side
 
     def __len__(self) -> int:
         return len(self.count)
 
 
 @lru_cache(maxsize=8)
-def screen_tiles(pixels: int, width: int) -> Tiles:
+def screen_tiles(pixels: int, width: int, size: int = TILE) -> Tiles:
     """The tiles of a whole frame (they depend on its size only)."""
-    tiles = make_tiles(np.arange(pixels), width)
+    tiles = make_tiles(np.arange(pixels), width, size)
     for a in (tiles.order, tiles.start, tiles.count, tiles.of_pixel):
         a.flags.writeable = False
     return tiles
 
 
-def make_tiles(pixels: np.ndarray, width: int) -> Tiles:
-    """Group active pixels (flat indices) into TILE x TILE screen tiles (empty ones dropped)."""
-    tx, ty = (pixels % width) // TILE, (pixels // width) // TILE
-    key = ty * ((width + TILE - 1) // TILE) + tx
+def make_tiles(pixels: np.ndarray, width: int, size: int = TILE) -> Tiles:
+    """Group active pixels (flat indices) into size x size screen tiles (empty ones dropped)."""
+    tx, ty = (pixels % width) // size, (pixels // width) // size
+    key = ty * ((width + size - 1) // size) + tx
     order = np.argsort(key, kind="stable")
     key = key[order]
     uniq, start, count = np.unique(key, return_index=True, return_counts=True)
-    return Tiles(order, start, count, np.repeat(np.arange(len(uniq)), count))
+    return Tiles(order, start, count, np.repeat(np.arange(len(uniq)), count), size)
+
+
+@lru_cache(maxsize=8)
+def screen_children(pixels: int, width: int) -> np.ndarray:
+    """(TILE tiles, k): the FINE tiles inside each TILE tile of a whole frame (-1 pads)."""
+    coarse, fine = screen_tiles(pixels, width), screen_tiles(pixels, width, FINE)
+    tile_of = np.empty(pixels, np.int64)
+    tile_of[coarse.order] = coarse.of_pixel
+    parent = tile_of[fine.order[fine.start]]  # the coarse tile of each fine tile's first pixel
+    order = np.argsort(parent, kind="stable")
+    parent = parent[order]
+    children = np.full((len(coarse), (TILE // FINE) ** 2), -1, dtype=np.int64)
+    children[parent, np.arange(len(parent)) - np.searchsorted(parent, parent)] = order
+    children.flags.writeable = False
+    return children
 
 
 @dataclass(frozen=True)
@@ -156,9 +173,10 @@ def grid_cones(x: np.ndarray, y: np.ndarray, z: np.ndarray, tiles: Tiles, width:
     first = tiles.order[tiles.start]  # each tile's first (top-left) pixel
     c0, r0 = first % width, first // width
     xs, ys, z = np.asarray(x, np.float64), np.asarray(y, np.float64), float(z)
+    size = tiles.size
     def span(v: np.ndarray, lo: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        blocks = np.pad(v, (0, -len(v) % TILE), mode="edge").reshape(-1, TILE)
-        return blocks.min(axis=1)[lo // TILE], blocks.max(axis=1)[lo // TILE]
+        blocks = np.pad(v, (0, -len(v) % size), mode="edge").reshape(-1, size)
+        return blocks.min(axis=1)[lo // size], blocks.max(axis=1)[lo // size]
     (xlo, xhi), (ylo, yhi) = span(xs, c0), span(ys, r0)
     corners = np.stack([np.stack(np.broadcast_arrays(cx, cy, z), axis=-1)
                         for cx in (xlo, xhi) for cy in (ylo, yhi)], axis=1)  # (tiles, 4, 3)
@@ -177,20 +195,31 @@ def cone_keep(cones: Cones, apex: np.ndarray, origins: Boxes | None,
 
     ``origins`` bounds the rays' origins per tile (None: the apex itself).
     """
-    v = b.center[sel] - apex
-    vunit, vlen = _unit(v)
+    vunit, vlen = _unit(b.center[sel] - apex)
     if origins is None:  # one bound per shape: the shortest direction of all tiles is the worst case
         r = cull_radius(b, sel, vlen[None, :], cones.dmin.min(), rnd)
     else:
         r = cull_radius(b, sel, origins.reach(b.center[sel]), cones.dmin, rnd)
+    return _in_cone(cones.axis @ vunit.T, cones.half[:, None], vlen[None, :], r)
+
+
+def cone_keep_cells(cones: Cones, tile: np.ndarray, apex: np.ndarray, b: Bounds, shape: np.ndarray,
+                    rnd: Rounding) -> np.ndarray:
+    """:func:`cone_keep` (rays from the apex) for the cells (tile[i], shape[i]) only."""
+    vunit, vlen = _unit(b.center[shape] - apex)
+    r = cull_radius(b, shape, vlen, cones.dmin.min(), rnd)
+    return _in_cone(np.einsum("ij,ij->i", cones.axis[tile], vunit), cones.half[tile], vlen, r)
+
+
+def _in_cone(cos_axis: np.ndarray, half: np.ndarray, vlen: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Whether a ball of radius r at distance vlen, at angle acos(cos_axis) from a cone's
+    axis, may meet the double cone of half-angle ``half`` (all broadcast)."""
     with np.errstate(all="ignore"):
-        spread = np.arcsin(np.clip(r / vlen[None, :], 0.0, 1.0)) + 1e-7
+        spread = np.arcsin(np.clip(r / vlen, 0.0, 1.0)) + 1e-7
     # angle(axis, centre line) <= half + spread, for lines (not half-lines), compared as
     # |cos angle| >= cos(half + spread) = cos(half) cos(spread) - sin(half) sin(spread)
-    half = cones.half[:, None]
     reach = np.cos(half) * np.cos(spread) - np.sin(half) * np.sin(spread)
-    near = np.abs(cones.axis @ vunit.T) >= reach
-    return near | (half + spread >= np.pi / 2) | (vlen[None, :] <= r) | ~np.isfinite(r)
+    return (np.abs(cos_axis) >= reach) | (half + spread >= np.pi / 2) | (vlen <= r) | ~np.isfinite(r)
 
 
 def depth_floor(b: Bounds, apex: np.ndarray, dmin: float, rnd: Rounding) -> np.ndarray:

@@ -15,8 +15,9 @@ import numpy as np
 
 from .arith import Arith
 from .camera import Rays, camera_rays
-from .cull import (PAIR_CHUNK, Bounds, Rounding, cone_keep, depth_floor, grid_cones, make_tiles, pairs, parallel_keep,
-                   parallel_rays, screen_tiles, shape_blocks, shape_bounds, tile_boxes, tile_cones, tile_reduce)
+from .cull import (FINE, PAIR_CHUNK, Bounds, Rounding, cone_keep, cone_keep_cells, depth_floor, grid_cones, make_tiles,
+                   pairs, parallel_keep, parallel_rays, screen_children, screen_tiles, shape_blocks, shape_bounds, tile_boxes,
+                   tile_cones, tile_reduce)
 from .frame import Frame
 from .lighting import Recorder, diffuse
 from .lights import POINT, Light, lights_from_scene
@@ -246,25 +247,33 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
     c2_shape = origin_term(ar, shapes, S_shape)
     tables = _direction_tables(ar, shapes, rays)
     form = uniform_form(shapes)
-    tiles = screen_tiles(n_pix, options.width)
+    coarse, tiles = screen_tiles(n_pix, options.width), screen_tiles(n_pix, options.width, FINE)
     rnd = Rounding.of(ar)
     apex = _f64(rays.origin)[0]
-    floor = order = cones = None
-    if options.cull:
-        cones = (grid_cones(*rays.grid, tiles, options.width) if rays.grid is not None
-                 else tile_cones(tiles, _f64(rays.direction)[tiles.order]))
+    floor = order = None
+    if options.cull:  # cones of the coarse tiles, then of the fine tiles inside the kept ones
+        children = screen_children(n_pix, options.width)
+        if rays.grid is not None:
+            cones, fine_cones = (grid_cones(*rays.grid, t, options.width) for t in (coarse, tiles))
+        else:
+            cones, fine_cones = (tile_cones(t, _f64(rays.direction)[t.order]) for t in (coarse, tiles))
         floor = depth_floor(bounds, apex, float(cones.dmin.min()), rnd)
         order = np.argsort(floor, kind="stable")  # front to back: near hits then skip far shapes
-    blocks = list(shape_blocks(len(shapes), len(tiles), order))
+    blocks = list(shape_blocks(len(shapes), len(coarse), order))
     for done, sel in enumerate(blocks):
+        reached = None
         if options.cull:
-            keep = cone_keep(cones, apex, None, bounds, sel, rnd)
-            # depth: a shape whose every hit is farther than a pixel's nearest so far cannot win it
-            reached = near.sqd.copy() if near.any else None
-            if reached is not None:
-                keep &= floor[sel][None, :] <= tile_reduce(tiles, reached[tiles.order], np.maximum)[:, None]
+            ci, si = np.nonzero(cone_keep(cones, apex, None, bounds, sel, rnd))
+            fi, si = children[ci].ravel(), np.repeat(si, children.shape[1])
+            fi, si = _pick(fi >= 0, fi, si)
+            ok = cone_keep_cells(fine_cones, fi, apex, bounds, sel[si], rnd)
+            if near.any:  # depth: a shape whose every hit is farther than a pixel's nearest so far cannot win it
+                reached = near.sqd.copy()
+                ok &= floor[sel[si]] <= tile_reduce(tiles, reached[tiles.order], np.maximum)[fi]
+            keep = np.zeros((len(tiles), len(sel)), bool)
+            keep[_pick(ok, fi, si)] = True
         else:
-            keep, reached = np.ones((len(tiles), len(sel)), bool), None
+            keep = np.ones((len(tiles), len(sel)), bool)
 
         def test(batch):
             pix, slot = batch

@@ -171,22 +171,30 @@ def grid_cones(x: np.ndarray, y: np.ndarray, z: np.ndarray, tiles: Tiles, width:
     pi/2 is convex), and the rectangle's point nearest the axis bounds their length.
     """
     first = tiles.order[tiles.start]  # each tile's first (top-left) pixel
-    c0, r0 = first % width, first // width
-    xs, ys, z = np.asarray(x, np.float64), np.asarray(y, np.float64), float(z)
+    z = float(z)
     size = tiles.size
+
     def span(v: np.ndarray, lo: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        v = np.asarray(v, np.float64)
         blocks = np.pad(v, (0, -len(v) % size), mode="edge").reshape(-1, size)
         return blocks.min(axis=1)[lo // size], blocks.max(axis=1)[lo // size]
-    (xlo, xhi), (ylo, yhi) = span(xs, c0), span(ys, r0)
-    corners = np.stack([np.stack(np.broadcast_arrays(cx, cy, z), axis=-1)
-                        for cx in (xlo, xhi) for cy in (ylo, yhi)], axis=1)  # (tiles, 4, 3)
-    unit, _ = _unit(corners)
-    axis, _ = _unit(unit.sum(axis=1))
-    cos = np.einsum("tkj,tj->tk", unit, axis).min(axis=1)
-    half = np.arccos(np.clip(cos, -1.0, 1.0)) + 1e-7
+
+    (xlo, xhi), (ylo, yhi) = span(x, first % width), span(y, first // width)
+    corners = [(cx, cy) for cx in (xlo, xhi) for cy in (ylo, yhi)]
+    units = []
+    for cx, cy in corners:
+        n = np.sqrt(cx * cx + cy * cy + z * z)
+        units.append((cx / n, cy / n, z / n))
+    ax, ay, az = (sum(u[k] for u in units) for k in range(3))
+    n = np.sqrt(ax * ax + ay * ay + az * az)
+    with np.errstate(all="ignore"):
+        ax, ay, az = ax / n, ay / n, az / n
+        cos = np.minimum.reduce([u[0] * ax + u[1] * ay + u[2] * az for u in units])
+        half = np.arccos(np.clip(cos, -1.0, 1.0)) + 1e-7
+    axis = np.stack([ax, ay, az], axis=1)
     half = np.where(np.isfinite(axis).all(axis=1) & (half < np.pi / 2), half, np.pi)
-    nearest = np.stack(np.broadcast_arrays(np.clip(0.0, xlo, xhi), np.clip(0.0, ylo, yhi), z), axis=-1)
-    return Cones(axis, half, np.linalg.norm(nearest, axis=1)[:, None])
+    nx, ny = np.clip(0.0, xlo, xhi), np.clip(0.0, ylo, yhi)
+    return Cones(axis, half, np.sqrt(nx * nx + ny * ny + z * z)[:, None])
 
 
 def cone_keep(cones: Cones, apex: np.ndarray, origins: Boxes | None,

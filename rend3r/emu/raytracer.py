@@ -134,8 +134,9 @@ def render_frame(
             lo, hi = job
             px, sl = _rows(hp[lo:hi]), _one(slot[lo:hi])
             D = tuple(c[px] for c in rays.direction)
-            if not lights:  # unlit: the point alone (for NaN checks), no normal
-                return surface(ar, None, None, None, near.t[px], rays.origin, D, normals=False)
+            if not lights:  # unlit: whether the point is finite is all that matters
+                point, _ = surface(ar, None, None, None, near.t[px], rays.origin, D, normals=False)
+                return np.isfinite(point[0]) & np.isfinite(point[1]) & np.isfinite(point[2])
             if tables is None:
                 s = shapes.take(sl)
                 _, Dh = to_object(ar, s, None, D)
@@ -145,18 +146,21 @@ def render_frame(
             return surface(ar, s, _take(S_shape, sl), Dh, near.t[px], rays.origin, D)
 
         parts = [hit_surface((lo, lo + PAIR_CHUNK)) for lo in range(0, len(hp), PAIR_CHUNK)]
-        empty = (np.zeros(0, ar.dtype),) * 3
-        point, normal = (tuple(np.concatenate([p[k][a] for p in parts]) if parts else empty[a] for a in range(3))
-                         if k == 0 or lights else None for k in range(2))
-        color, bad = shade_hits(ar, options, shapes, bounds, lights, hp, slot, point, normal, st, nan_pixel)
+        if lights:
+            empty = (np.zeros(0, ar.dtype),) * 3
+            point, normal = (tuple(np.concatenate([p[k][a] for p in parts]) if parts else empty[a] for a in range(3))
+                             for k in range(2))
+            color, bad = shade_hits(ar, options, shapes, bounds, lights, hp, slot, point, normal, st, nan_pixel)
+        else:  # unlit: the shape's colour where the hit point is finite
+            color, bad = shapes.color[slot], ~np.concatenate(parts) if parts else np.zeros(0, bool)
         if bad.any():
             nan_pixel[hp[bad]] = True
             hp, slot, color = hp[~bad], slot[~bad], color[~bad]
         st.hits = len(hp)
         hp = _rows(hp)
         rgb[hp] = color
-        depth[hp] = np.sqrt(near.sqd[hp].astype(np.float64))
         prov[hp] = shapes.index[slot]
+        np.copyto(depth, np.sqrt(near.sqd, dtype=np.float64), where=prov >= 0)
     st.nan_rays = int(nan_pixel.sum())
     st.seconds = perf_counter() - start
     frame = Frame(number, rgb.reshape(h, w), depth.reshape(h, w), prov.reshape(h, w))

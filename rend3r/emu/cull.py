@@ -382,9 +382,17 @@ def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray,
         hi = int(np.searchsorted(ends, (ends[lo - 1] if lo else 0) + PAIR_CHUNK, side="right"))
         hi = min(max(hi, lo + 1), stop)
         c = counts[lo:hi]
-        total = int(c.sum())
-        first = np.repeat(tiles.start[ti[lo:hi]] - np.concatenate(([0], np.cumsum(c)[:-1])), c)
-        yield tiles.order[first + np.arange(total)], np.repeat(sel[si[lo:hi]], c)
+        cells, shapes = ti[lo:hi], si[lo:hi]
+        if cells[-1] - cells[0] == hi - lo - 1:  # consecutive tiles: their positions are one run
+            begin = int(tiles.start[cells[0]])
+            pos = tiles.order[begin:begin + int(c.sum())]
+        else:
+            first = np.repeat(tiles.start[cells] - np.concatenate(([0], np.cumsum(c)[:-1])), c)
+            pos = tiles.order[first + np.arange(int(c.sum()))]
+        if (shapes == shapes[0]).all():  # one shape: a read-only broadcast, not a copy
+            yield pos, np.broadcast_to(sel[shapes[0]], pos.shape)
+        else:
+            yield pos, np.repeat(sel[shapes], c)
         lo = hi
 
 

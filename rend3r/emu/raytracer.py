@@ -53,14 +53,18 @@ def _rows(idx: np.ndarray) -> np.ndarray | slice:
 def _one(slots: np.ndarray) -> np.ndarray | int:
     """Shape positions, or the one position when all are the same (its values then enter
     as scalars, which broadcast)."""
-    return int(slots[0]) if len(slots) and (slots == slots[0]).all() else slots
+    if len(slots) and (slots.strides == (0,) or (slots == slots[0]).all()):
+        return int(slots[0])
+    return slots
 
 
 def _pick(mask: np.ndarray, *arrays: np.ndarray) -> tuple[np.ndarray, ...]:
     """Each array's entries where ``mask`` holds: one index pass, then gathers (boolean
-    indexing is several times slower on irregular masks)."""
+    indexing is several times slower on irregular masks). A broadcast of one value stays
+    a broadcast."""
     idx = np.flatnonzero(mask)
-    return tuple(np.take(a, idx) for a in arrays)
+    return tuple(np.broadcast_to(a[0], idx.shape) if a.strides == (0,) and len(a) else np.take(a, idx)
+                 for a in arrays)
 
 
 class _Nearest:

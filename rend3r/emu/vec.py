@@ -69,11 +69,35 @@ def hamilton_pure(ar: Arith, a: Quat, v: Vec) -> Quat:
 
 def rotate_inverse(ar: Arith, q: Quat, v: Vec) -> Vec:
     """World to object: conj(q) * (0, v) * q (scaled by |q|^2 when q is not unit)."""
+    if _is_identity(q) and _plain(ar, v):
+        return v
     w = hamilton(ar, hamilton_pure(ar, conj(ar, q), v), q, real=False)
     return (w[1], w[2], w[3])
 
 
 def rotate(ar: Arith, q: Quat, v: Vec) -> Vec:
     """Object to world: q * (0, v) * conj(q)."""
+    if _is_identity(q) and _plain(ar, v):
+        return v
     w = hamilton(ar, hamilton_pure(ar, q, v), conj(ar, q), real=False)
     return (w[1], w[2], w[3])
+
+
+def _is_identity(q: Quat) -> bool:
+    """Whether q is exactly (1, +0, +0, +0) (in every entry, for arrays)."""
+    r, *ijk = (np.asarray(c) for c in q)
+    return bool((r == 1).all()) and all(bool(((c == 0) & ~np.signbit(c)).all()) for c in ijk)
+
+
+def _plain(ar: Arith, v: Vec) -> bool:
+    """Whether every component of v is finite and at least the smallest normal number in
+    magnitude.
+
+    Then both rotations by exactly (1, +0, +0, +0) return v itself, bit for bit: every
+    product with a zero component of q is a signed zero, every sum adds a signed zero to
+    x, y or z (or two signed zeros to each other) and leaves the nonzero value as it is,
+    and no rounding or flush changes a value that is already in the working format and
+    normal. Zeros, subnormals, infinities and NaN take the full computation (their signs
+    and NaNs depend on it).
+    """
+    return all(bool((np.isfinite(c) & (np.abs(c) >= ar.tiny)).all()) for c in v)

@@ -185,3 +185,24 @@ def test_distinct_merges_equal_the_general_merge(seed):
         fast.update(pix, slot, sqd, t, distinct=True, hit=hit)
     assert (general.sqd == fast.sqd).all() and (general.slot == fast.slot).all()
     assert (general.t.view(np.uint32) == fast.t.view(np.uint32)).all()
+
+
+component = st.one_of(st.floats(-1000, 1000, width=16), st.floats(allow_nan=True, allow_infinity=True, width=32),
+                      st.sampled_from([0.0, -0.0, 1e-40, -1e-40, 2.0**-14, -(2.0**-15), 65504.0, 1e30]))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.sampled_from(ARITHS), st.lists(st.tuples(component, component, component), min_size=1, max_size=8))
+def test_identity_rotations_skip_no_bit(arith, rows):
+    """Rotating by exactly (1, +0, +0, +0) may return v itself: only when that is what the
+    full device-order computation gives, bit for bit."""
+    from rend3r.emu.vec import conj, hamilton, hamilton_pure, rotate, rotate_inverse
+    ar = make_arith(*arith)
+    v = tuple(ar.round(np.array([r[k] for r in rows], dtype=np.float64).astype(ar.dtype)) for k in range(3))
+    q = tuple(ar.const(c) for c in (1.0, 0.0, 0.0, 0.0))
+    full_inv = hamilton(ar, hamilton_pure(ar, conj(ar, q), v), q, real=False)[1:]
+    full_fwd = hamilton(ar, hamilton_pure(ar, q, v), conj(ar, q), real=False)[1:]
+    bits = np.uint32 if ar.dtype == np.float32 else np.uint64
+    for got, want in ((rotate_inverse(ar, q, v), full_inv), (rotate(ar, q, v), full_fwd)):
+        for g, w in zip(got, want):
+            assert (np.asarray(g).view(bits) == np.asarray(w).view(bits)).all()

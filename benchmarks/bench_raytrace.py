@@ -8,7 +8,7 @@ device estimate (shapes + 205) * (lights + 1) * pixels cycles at 100 MHz, and
 device/emulator ratios; first, a calibration figure of the machine's numpy speed.
 Targets: fp16 faster than the device on every row; fp32 at least 10x faster.
 
-    python benchmarks/bench_raytrace.py [--runs 5] [--shapes 1 16 256 4096] [--precision fp16 fp32]
+    python benchmarks/bench_raytrace.py [--runs 5] [--shapes 1 16 256 4096] [--precision fp16 fp32] [--rotated]
 """
 
 from __future__ import annotations
@@ -32,8 +32,16 @@ def _prop(table: Table, name: str) -> int:
     return lookup(table, name).index
 
 
-def workload(shapes: int, lights: int) -> list[int]:
-    """The program: camera, optional light, the sphere wall, nf, er."""
+#: --rotated: every sphere turned 30 degrees about (1, 1, 1) (unit quaternion, float16).
+TURN = (0.9658, 0.1494, 0.1494, 0.1494)
+
+
+def workload(shapes: int, lights: int, rotated: bool = False) -> list[int]:
+    """The program: camera, optional light, the sphere wall, nf, er.
+
+    ``rotated`` gives every sphere a rotation: the same image, but the raycaster cannot
+    take its shortcut for unrotated shapes (docs/emulator.md, section 11).
+    """
     g, k = LAYOUT[shapes]
     spacing = 8.0 / g
     inv = 1.0 / (0.45 * spacing)
@@ -54,10 +62,11 @@ def workload(shapes: int, lights: int) -> list[int]:
                 for (p1, v1), (p2, v2) in (
                     (("type", 1), ("col", colour)),
                     (("xloc", float_to_bits(x)), ("yloc", float_to_bits(y))),
-                    (("zloc", float_to_bits(z)), ("rrot", float_to_bits(1.0))),
+                    (("zloc", float_to_bits(z)), ("rrot", float_to_bits(TURN[0] if rotated else 1.0))),
                     (("xscl", float_to_bits(inv)), ("yscl", float_to_bits(inv))),
                     (("zscl", float_to_bits(inv)), ("mat", 0)),
-                ):
+                ) + ((("irot", float_to_bits(TURN[1])), ("jrot", float_to_bits(TURN[2]))),
+                     (("krot", float_to_bits(TURN[3])), ("mat", 0))) * rotated:
                     words += encode(ShapeSet(index, s(p1), s(p2), v1, v2))
                 index += 1
     return words + list(encode(FrameOp(Func.NF))) + list(encode(FrameOp(Func.ER)))
@@ -93,6 +102,7 @@ def main() -> None:
     ap.add_argument("--shapes", type=int, nargs="+", default=[1, 16, 256, 4096], choices=sorted(LAYOUT))
     ap.add_argument("--lights", type=int, nargs="+", default=[0, 1], choices=[0, 1])
     ap.add_argument("--precision", nargs="+", default=["fp16", "fp32"], choices=["fp16", "fp32", "fp64"])
+    ap.add_argument("--rotated", action="store_true", help="turn every sphere (no shortcut for unrotated shapes)")
     args = ap.parse_args()
     pixels = 512 * 384
     print(f"machine: a float32 multiply of 65,536 elements takes {_calibration_us():.1f} us (median of 7)")
@@ -100,7 +110,7 @@ def main() -> None:
           f"{'target':>7} {'tests':>11} {'skipped':>13} {'hits':>7} {'nan':>9}")
     for lights in args.lights:
         for shapes in args.shapes:
-            words = workload(shapes, lights)
+            words = workload(shapes, lights, args.rotated)
             device = device_cycles(shapes, lights, pixels) / CLOCK_HZ
             for precision in args.precision:
                 secs, st = measure(words, precision, args.runs)

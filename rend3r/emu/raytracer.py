@@ -321,6 +321,9 @@ def shade_hits(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, l
     rasterizer) with shadow rays as its occlusion test; ``record`` sees every stage.
     """
     def occluded(light: Light, lit: np.ndarray, l_lit: Vec) -> np.ndarray:
+        if len(shapes) < 2:  # nothing else to cast a shadow
+            st.shadow_rays += len(lit)
+            return np.zeros(len(lit), dtype=bool)
         return _shadowed(ar, options, shapes, bounds, light, _take(point, lit), l_lit, hp[lit], slot[lit], st, nan_pixel)
 
     return diffuse(ar, shapes.color[slot], normal, point, lights, occluded, options.intensity_fixed, record)
@@ -332,7 +335,7 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
     n = len(pix)
     blocked = np.zeros(n, dtype=bool)
     st.shadow_rays += n
-    if n == 0 or len(shapes) < 2:
+    if n == 0:
         return blocked
     tmax = ar.const(1.0 if light.kind == POINT else np.inf)
     tmin = ar.const(0.0)

@@ -1,13 +1,15 @@
 """Conservative culling: which (pixel tile, shape) tests can be skipped without effect.
 
-A shape test is skipped only when every ray of the tile provably misses the shape *as the
-working-precision raycaster computes it* (not merely in exact arithmetic). The bound, derived
-in ``docs/emulator.md``: in the shape's normal space the ray line stays farther than
-``sqrt(1 + 24 u (1 + M^2)) + 16 u M (1 + k)`` from the origin, where ``u`` is the unit
-roundoff (float16's, with a flush-to-zero term), ``M`` bounds |S| in normal space and ``k``
-is the condition number of the shape's linear map. Then the computed discriminant is
-negative. Only spheres with moderate scales and rotations are culled; every other shape
-is tested against every pixel.
+A shape test is skipped only when it provably cannot change a pixel *as the
+working-precision raycaster computes it* (not merely in exact arithmetic); the bounds are
+derived in ``docs/emulator.md``, section 7. Off the line: in the shape's normal space the
+ray line stays farther than ``sqrt(1 + 24 u (1 + M^2)) + 16 u M (1 + k)`` from the origin,
+where ``u`` is the working precision's unit roundoff (with an underflow term), ``M``
+bounds |S| in normal space and ``k`` is the condition number of the shape's linear map;
+then the computed discriminant is negative. Behind: a shadow ray's shape lies behind its
+origin, or a primary ray already has a hit nearer than the shape's depth floor (a lower
+bound of any computed hit distance). Only spheres with moderate scales and rotations are
+culled; every other shape is tested against every pixel.
 """
 
 from __future__ import annotations

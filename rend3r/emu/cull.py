@@ -385,7 +385,7 @@ def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray,
         hi = min(max(hi, lo + 1), stop)
         c = counts[lo:hi]
         cells, shapes = ti[lo:hi], si[lo:hi]
-        if cells[-1] - cells[0] == hi - lo - 1:  # consecutive tiles: their positions are one run
+        if (np.diff(cells) == 1).all():  # consecutive tiles: their positions are one run
             begin = int(tiles.start[cells[0]])
             pos = tiles.order[begin:begin + int(c.sum())]
         else:

@@ -232,11 +232,11 @@ def _in_cone(cos_axis: np.ndarray, half: np.ndarray, vlen: np.ndarray, r: np.nda
     return (np.abs(cos_axis) >= reach) | (half + spread >= np.pi / 2) | (vlen <= r) | ~np.isfinite(r)
 
 
-def depth_floor(b: Bounds, apex: np.ndarray, dmin: float, rnd: Rounding) -> np.ndarray:
+def depth_floor(b: Bounds, apex: np.ndarray, dmin: float, dmax: float, rnd: Rounding) -> np.ndarray:
     """Per shape, a lower bound of the computed ``sq_dist`` of any hit by a ray from ``apex``.
 
     0 where no bound is claimed (shapes that are not cullable spheres, apex inside or near
-    the shape). ``dmin`` bounds the rays' direction lengths from below. Derivation:
+    the shape). ``dmin`` and ``dmax`` bound the rays' direction lengths. Derivation:
     ``docs/emulator.md`` section 7.
     """
     tiny = rnd.tiny
@@ -258,7 +258,8 @@ def depth_floor(b: Bounds, apex: np.ndarray, dmin: float, rnd: Rounding) -> np.n
             return bb - np.sqrt(np.maximum(0.0, alpha * bb * bb - beta * ac))
         t_lo = (1.0 - uu) ** 2 * np.minimum(num(b_min), num(b_max)) / a_hi
         floor = (1.0 - uu) ** 6 * (1.0 - 4.0 * uu) * t_lo**2 * (1.0 - _SLACK)
-        ok = b.cullable & (dlo >= 2.0**-4) & (e < 0.25) & (c_lo > 0) & (b_min > 0) & (t_lo >= 2.0**-13)
+        # the actual t is t_lo / |d| at least; 2 sqrt(tiny) keeps t and t*t clear of underflow
+        ok = b.cullable & (dlo >= 2.0**-4) & (e < 0.25) & (c_lo > 0) & (b_min > 0) & (t_lo >= 2.0 * np.sqrt(tiny) * dmax)
         return np.where(ok & np.isfinite(floor), floor, 0.0)
 
 

@@ -214,6 +214,15 @@ def _direction_tables(ar: Arith, shapes: Shapes, rays: Rays) -> _DirectionTables
     return _DirectionTables(first, cls, len(first) == 1, n, columns)
 
 
+def _longest(rays: Rays) -> float:
+    """An upper bound of the primary directions' lengths."""
+    if rays.grid is not None:
+        x, y, z = (np.abs(np.asarray(c, np.float64)).max(initial=0.0) for c in rays.grid)
+        return float(np.sqrt(x * x + y * y + z * z)) * (1 + 1e-9)
+    d = _f64(rays.direction)
+    return float(np.sqrt(np.einsum("ij,ij->i", d, d).max(initial=0.0))) * (1 + 1e-9)
+
+
 def _squared_lengths(ar: Arith, rays: Rays) -> np.ndarray:
     """|d|^2 of every primary ray (from a grid camera, products once per column and row)."""
     if rays.grid is None:
@@ -265,25 +274,32 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
             cones, fine_cones = (grid_cones(*rays.grid, t, options.width) for t in (coarse, tiles))
         else:
             cones, fine_cones = (tile_cones(t, _f64(rays.direction)[t.order]) for t in (coarse, tiles))
-        floor = depth_floor(bounds, apex, float(cones.dmin.min()), rnd)
+        floor = depth_floor(bounds, apex, float(cones.dmin.min()), _longest(rays), rnd)
         order = np.argsort(floor, kind="stable")  # front to back: near hits then skip far shapes
     blocks = list(shape_blocks(len(shapes), len(coarse), order))
     for done, sel in enumerate(blocks):
-        reached = None
+        # (cells, nearest hits to filter their pairs by): cells that need no depth check,
+        # then cells whose tile has some pixel nearer than the shape's floor
+        passes = [(np.ones((len(tiles), len(sel)), bool), None)]
         if options.cull:
             ci, si = np.nonzero(cone_keep(cones, apex, None, bounds, sel, rnd))
             fi, si = children[ci].ravel(), np.repeat(si, children.shape[1])
             fi, si = _pick(fi >= 0, fi, si)
-            ok = cone_keep_cells(fine_cones, fi, apex, bounds, sel[si], rnd)
+            fi, si = _pick(cone_keep_cells(fine_cones, fi, apex, bounds, sel[si], rnd), fi, si)
+            sure = np.ones(len(fi), bool)
             if near.any:  # depth: a shape whose every hit is farther than a pixel's nearest so far cannot win it
                 reached = near.sqd.copy()
-                ok &= floor[sel[si]] <= tile_reduce(tiles, reached[tiles.order], np.maximum)[fi]
-            keep = np.zeros((len(tiles), len(sel)), bool)
-            keep[_pick(ok, fi, si)] = True
-        else:
-            keep = np.ones((len(tiles), len(sel)), bool)
+                in_tiles = reached[tiles.order]
+                low = floor[sel[si]]
+                sure = low <= tile_reduce(tiles, in_tiles, np.minimum)[fi]
+                check = ~sure & (low <= tile_reduce(tiles, in_tiles, np.maximum)[fi])
+            passes = []
+            for cells, nearest in ((sure, None), (check, reached)) if near.any else ((sure, None),):
+                keep = np.zeros((len(tiles), len(sel)), bool)
+                keep[_pick(cells, fi, si)] = True
+                passes.append((keep, nearest))
 
-        def test(batch):
+        def test(batch, reached):
             pix, slot = batch
             if reached is not None:
                 pix, slot = _pick(np.take(floor, slot) <= np.take(reached, pix), pix, slot)
@@ -300,11 +316,13 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
             bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
             return pix, slot, sqd, sol.t, sol.hit & ~bad, bad
 
-        for pix, slot, sqd, t, hit, bad in map(test, pairs(tiles, keep, sel, distinct=True)):
-            st.tests += len(pix)
-            st.nan_tests += int(bad.sum())
-            nan_pixel[_pick(bad, pix)[0]] = True
-            near.update(pix, slot, sqd, t, distinct=True, hit=hit)
+        for keep, reached in passes:
+            for batch in pairs(tiles, keep, sel, distinct=True):
+                pix, slot, sqd, t, hit, bad = test(batch, reached)
+                st.tests += len(pix)
+                st.nan_tests += int(bad.sum())
+                nan_pixel[_pick(bad, pix)[0]] = True
+                near.update(pix, slot, sqd, t, distinct=True, hit=hit)
         if progress is not None:
             progress((done + 1) / len(blocks))
     st.skipped += n_pix * len(shapes) - st.tests

@@ -52,8 +52,9 @@ def test_depth_floor_bounds_every_computed_hit(arith, loc, inv, stretch, q, cam,
     aim = (c64 - o64) + rng.normal(size=(4000, 3)) * radius * rng.uniform(0.2, 1.5)
     aim *= rng.uniform(0.5, 4.0, size=(4000, 1))
     d = tuple(ar.round(aim[:, k].astype(np.float32 if ar.dtype == np.float32 else np.float64)) for k in range(3))
-    dmin = float(np.min(np.sqrt(sum(np.asarray(c, np.float64) ** 2 for c in d))))
-    floor = depth_floor(shape_bounds(shapes), o64, dmin * (1 - 1e-6), Rounding.of(ar))[0]
+    length = np.sqrt(sum(np.asarray(c, np.float64) ** 2 for c in d))
+    floor = depth_floor(shape_bounds(shapes), o64, length.min() * (1 - 1e-6), length.max() * (1 + 1e-6),
+                        Rounding.of(ar))[0]
     s = shapes.take(0)
     S, D = to_object(ar, s, origin, d)
     sol = solve(ar, s, S, D, origin_term(ar, s, S), ar.const(0.0), ar.const(np.inf))

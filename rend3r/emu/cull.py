@@ -402,6 +402,6 @@ def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray,
 def shape_blocks(n: int, tiles: int, order: np.ndarray | None = None) -> Iterator[np.ndarray]:
     """Shape positions (in ``order`` if given) in blocks that keep a (tiles, block) matrix
     modest, and that are small enough for depth culling to act between blocks."""
-    step = max(1, min((1 << 21) // max(1, tiles), max(64, -(-n // 16))))
+    step = max(1, min((1 << 21) // max(1, tiles), max(256, -(-n // 16))))
     for lo in range(0, n, step):
         yield np.arange(lo, min(n, lo + step)) if order is None else order[lo:lo + step]

@@ -64,15 +64,16 @@ def test_depth_floor_bounds_every_computed_hit(arith, loc, inv, stretch, q, cam,
     assert (np.asarray(sqd[hit], np.float64) >= floor).all()
 
 
-def _deep(n: int = 4, k: int = 4, depth_step: float = 0.6, **cam) -> Prog:
-    """An n x n wall of columns k deep: front spheres hide most of the ones behind."""
+def _deep(n: int = 4, k: int = 4, depth_step: float = 0.6, inv: float = 2.4, **cam) -> Prog:
+    """An n x n wall of columns k deep (inverse scale inv / spacing): front spheres hide
+    most of the ones behind."""
     p = Prog().nr().cam(hfov=0.25, vfov=0.25, **cam)
     spacing = 4.0 / n
     for i in range(n):
         for j in range(n):
             for d in range(k):
                 x, y = (i - (n - 1) / 2) * spacing, (j - (n - 1) / 2) * spacing
-                p.sphere(((i * n) + j) * k + d, loc=(x, y, -3.0 - d * depth_step), scale=(2.4 / spacing,) * 3,
+                p.sphere(((i * n) + j) * k + d, loc=(x, y, -3.0 - d * depth_step), scale=(inv / spacing,) * 3,
                          col=(i * 4 + j * 2 + d) & 0xFFFF or 1)
     return p
 
@@ -89,9 +90,20 @@ def _same(prog: Prog, **opts) -> tuple:
 @pytest.mark.parametrize("precision,subnormals", ARITHS)
 @pytest.mark.parametrize("cam", [{}, {"rrot": 0.96, "jrot": 0.1, "irot": -0.05}], ids=["grid", "rotated"])
 def test_deep_scenes_are_bit_identical_with_and_without_culling(precision, subnormals, cam):
-    prog = _deep(**cam).dir_light(0, forward=(0.3, -0.2, -1.0)).light(1, src=2, xloc=0.5, yloc=2.0, zloc=1.0)
+    prog = _deep(n=8, k=5, **cam).dir_light(0, forward=(0.3, -0.2, -1.0)).light(1, src=2, xloc=0.5, yloc=2.0, zloc=1.0)
     culled, full = _same(prog.nf(), precision=precision, subnormals=subnormals)
-    assert culled.tests < full.tests / 4  # the front layer hides the rest: depth culling acts
+    assert culled.tests < full.tests / 4
+
+
+@pytest.mark.parametrize("precision,share", [("fp16", 0.9), ("fp32", 0.5)])
+def test_depth_culling_acts_on_deep_scenes(precision, share, monkeypatch):
+    """768 spheres in 12 layers (three blocks): the front blocks hide most of the rest
+    (float16's looser floor skips less)."""
+    prog = _deep(n=8, k=12, depth_step=0.3, inv=1.2).nf()  # float16-sized: no overflow
+    run = lambda: run_program(prog.words, EmuOptions(width=80, height=60, precision=precision)).stats.frames[0]  # noqa: E731
+    with_floor = run().tests
+    monkeypatch.setattr(rt, "depth_floor", lambda b, *rest: np.zeros(len(b.smin)))
+    assert with_floor < share * run().tests
 
 
 def test_equal_spheres_at_equal_depth_keep_the_lower_index():

@@ -182,14 +182,13 @@ def grid_cones(x: np.ndarray, y: np.ndarray, z: np.ndarray, tiles: Tiles, width:
         return blocks.min(axis=1)[lo // size], blocks.max(axis=1)[lo // size]
 
     (xlo, xhi), (ylo, yhi) = span(x, first % width), span(y, first // width)
-    corners = [(cx, cy) for cx in (xlo, xhi) for cy in (ylo, yhi)]
-    units = []
-    for cx, cy in corners:
-        n = np.sqrt(cx * cx + cy * cy + z * z)
-        units.append((cx / n, cy / n, z / n))
-    ax, ay, az = (sum(u[k] for u in units) for k in range(3))
-    n = np.sqrt(ax * ax + ay * ay + az * az)
-    with np.errstate(all="ignore"):
+    with np.errstate(all="ignore"):  # a zero or non-finite direction gives NaN: half-angle pi below
+        units = []
+        for cx, cy in ((cx, cy) for cx in (xlo, xhi) for cy in (ylo, yhi)):
+            n = np.sqrt(cx * cx + cy * cy + z * z)
+            units.append((cx / n, cy / n, z / n))
+        ax, ay, az = (sum(u[k] for u in units) for k in range(3))
+        n = np.sqrt(ax * ax + ay * ay + az * az)
         ax, ay, az = ax / n, ay / n, az / n
         cos = np.minimum.reduce([u[0] * ax + u[1] * ay + u[2] * az for u in units])
         half = np.arccos(np.clip(cos, -1.0, 1.0)) + 1e-7

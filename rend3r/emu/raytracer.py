@@ -15,9 +15,9 @@ import numpy as np
 
 from .arith import Arith
 from .camera import Rays, camera_rays
-from .cull import (FINE, PAIR_CHUNK, Bounds, Rounding, cone_keep, cone_keep_cells, depth_floor, grid_cones, make_tiles,
-                   pairs, parallel_keep, parallel_rays, screen_children, screen_tiles, shape_blocks, shape_bounds, tile_boxes,
-                   tile_cones, tile_reduce)
+from .cull import (FINE, PAIR_CHUNK, Bounds, Rounding, cone_keep, cone_keep_cells, depth_floor, grid_cones, pairs,
+                   parallel_keep, parallel_rays, screen_children, screen_tiles, shape_blocks, shape_bounds, subset_tiles,
+                   tile_boxes, tile_cones, tile_reduce)
 from .frame import Frame
 from .lighting import Recorder, diffuse
 from .lights import POINT, Light, lights_from_scene
@@ -35,6 +35,14 @@ _NONE = np.iinfo(np.int64).max
 def _f64(v: Vec) -> np.ndarray:
     """(n, 3) float64 view of a vector for culling geometry."""
     return np.stack(np.broadcast_arrays(*[np.atleast_1d(np.asarray(c, np.float64)) for c in v]), axis=-1)
+
+
+def _f64_rows(v: Vec, idx: np.ndarray) -> np.ndarray:
+    """(len(idx), 3) float64 rows of a vector's entries ``idx`` (components may be scalars)."""
+    out = np.empty((len(idx), 3))
+    for k, c in enumerate(v):
+        out[:, k] = np.take(c, idx) if np.ndim(c) else c
+    return out
 
 
 def _take(v: Vec, idx: np.ndarray) -> Vec:
@@ -357,14 +365,14 @@ def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, li
         return blocked
     tmax = ar.const(1.0 if light.kind == POINT else np.inf)
     tmin = ar.const(0.0)
-    tiles = make_tiles(pix, options.width)
+    tiles = subset_tiles(screen_tiles(options.pixels, options.width), pix)  # pix: sorted hit pixels
     rnd = Rounding.of(ar)
     before = st.tests
     if options.cull:
-        org = _f64(origin)[tiles.order]
+        org = _f64_rows(origin, tiles.order)
         if light.kind == POINT:
             apex = _f64(light.location)[0]
-            cones = tile_cones(tiles, _f64(direction)[tiles.order])
+            cones = tile_cones(tiles, _f64_rows(direction, tiles.order))
             boxes = tile_boxes(tiles, org)
         else:
             bundle = parallel_rays(tiles, _f64(direction)[0], org)

@@ -219,3 +219,15 @@ def test_identity_rotations_skip_no_bit(arith, rows):
     for got, want in ((rotate_inverse(ar, q, v), full_inv), (rotate(ar, q, v), full_fwd)):
         for g, w in zip(got, want):
             assert (np.asarray(g).view(bits) == np.asarray(w).view(bits)).all()
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**31), st.sampled_from([(64, 48), (100, 75)]))
+def test_subset_tiles_equal_sorting_the_subset(seed, size):
+    from rend3r.emu.cull import make_tiles, subset_tiles
+    w, h = size
+    rng = np.random.default_rng(seed)
+    pixels = np.flatnonzero(rng.random(w * h) < rng.uniform(0.01, 1.0))
+    a, b = subset_tiles(screen_tiles(w * h, w), pixels), make_tiles(pixels, w)
+    for name in ("order", "start", "count", "of_pixel"):
+        assert (getattr(a, name) == getattr(b, name)).all()

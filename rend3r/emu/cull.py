@@ -71,12 +71,13 @@ def screen_tiles(pixels: int, width: int, size: int = TILE) -> Tiles:
 
 
 def subset_tiles(screen: Tiles, pixels: np.ndarray) -> Tiles:
-    """:func:`make_tiles` of some pixels of a whole frame (sorted, distinct flat indices),
-    read off the frame's tiles instead of sorted again."""
-    member = np.zeros(len(screen.order), bool)
-    member[pixels] = True
-    inside = member[screen.order]
-    order = np.searchsorted(pixels, screen.order[inside])
+    """:func:`make_tiles` of some pixels of a whole frame (distinct flat indices, in
+    increasing order), read off the frame's tiles instead of sorted again."""
+    position = np.full(len(screen.order), -1, dtype=np.int64)  # of each pixel in ``pixels``
+    position[pixels] = np.arange(len(pixels))
+    in_order = np.take(position, screen.order)
+    inside = in_order >= 0
+    order = np.take(in_order, np.flatnonzero(inside))
     count = np.add.reduceat(inside, screen.start, dtype=np.int64)
     count = count[count > 0]
     start = np.concatenate(([0], np.cumsum(count)[:-1]))
@@ -333,9 +334,8 @@ def parallel_rays(tiles: Tiles, direction: np.ndarray, origins: np.ndarray) -> P
     e1 = np.cross(d, [1.0, 0.0, 0.0] if abs(d[0]) < 0.9 else [0.0, 1.0, 0.0])
     e1 /= np.linalg.norm(e1)
     basis = np.stack([e1, np.cross(d, e1)], axis=1)
-    cols = np.concatenate([origins @ np.column_stack([basis, d]), origins], axis=1)  # plane, along d, space
-    lo, hi = tile_reduce(tiles, cols, np.minimum), tile_reduce(tiles, cols, np.maximum)
-    return ParallelRays(d, float(dlen), basis, Boxes(lo[:, :2], hi[:, :2]), Boxes(lo[:, 3:], hi[:, 3:]), lo[:, 2])
+    return ParallelRays(d, float(dlen), basis, tile_boxes(tiles, origins @ basis), tile_boxes(tiles, origins),
+                        tile_reduce(tiles, origins @ d, np.minimum))
 
 
 def parallel_keep(rays: ParallelRays, b: Bounds, sel: np.ndarray, rnd: Rounding) -> np.ndarray:

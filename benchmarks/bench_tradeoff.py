@@ -27,6 +27,7 @@ from rend3r.emu import EmuOptions, load_program, run_program
 from rend3r.errors import Rend3rError
 from rend3r.golden.catalog import ExampleProgram, discover
 from rend3r.golden.metrics import image_metrics, provenance_metrics
+from rend3r.memory import reuse_freed_memory
 
 ROOT = Path(__file__).resolve().parents[1]
 MODES: dict[str, dict[str, str]] = {
@@ -202,6 +203,7 @@ def plot(rows: list[Row], path: Path) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    reuse_freed_memory()  # as the rend3r command does (rend3r/memory.py)
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--programs", type=Path, default=ROOT / "programs")
     ap.add_argument("--size", default="256x192", help="image size WxH (default 256x192)")

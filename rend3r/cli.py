@@ -13,6 +13,7 @@ import click
 
 from . import __version__
 from .errors import Rend3rError
+from .memory import reuse_freed_memory
 
 #: command name -> ("module:attribute", one-line help shown by ``rend3r --help``)
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -42,6 +43,7 @@ class LazyGroup(click.Group):
         return getattr(importlib.import_module(module_name), attr)
 
     def invoke(self, ctx: click.Context):
+        reuse_freed_memory()  # the renderers' temporaries: see rend3r/memory.py
         try:
             return super().invoke(ctx)
         except Rend3rError as exc:

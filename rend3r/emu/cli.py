@@ -142,7 +142,8 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
     nan = result.stats.nan_rays
     if nan:
         click.echo(f"rend3r: warning: {nan} rays met NaN or infinity and were counted as misses "
-                   f"({int(result.stats.total('nan_tests'))} shape tests); see --stats", err=True)
+                   f"({int(result.stats.total('nan_tests'))} of the shape tests performed; culling skips tests "
+                   f"that cannot change a pixel, overflowing ones included); see --stats", err=True)
     if show_stats:
         click.echo(result.stats.report())
 

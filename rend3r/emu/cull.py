@@ -377,8 +377,8 @@ def pairs(tiles: Tiles, keep: np.ndarray, sel: np.ndarray,
     """(active position, shape position) pairs of the kept (tile, shape) cells, in batches.
 
     ``distinct``: no batch holds a position twice. Cells then go by rank within their
-    tile (every tile's first cell, then every second cell, ...) and batches do not mix
-    ranks; otherwise they go tile by tile.
+    tile (each tile's first cell, then each tile's second cell, ...) and batches do not
+    mix ranks; otherwise they go tile by tile.
     """
     ti, si = np.nonzero(keep)
     if not len(ti):

@@ -92,7 +92,7 @@ def diffuse(
         weight = np.zeros(len(base))
         np.copyto(weight, factor, where=on)
         for c, (ch, (shift, top)) in enumerate(zip(channels, _CHANNELS)):
-            term = np.multiply(weight, ch)  # float64: exact, as the channel values are small integers
+            term = np.multiply(weight, ch)  # float64, the channel cast exactly: factor * channel, then * scale
             term *= ((light.color >> shift) & top) / top
             acc[c] = term if acc[c] is None else np.add(acc[c], term, out=acc[c])
     out = np.zeros(len(base), np.uint16)

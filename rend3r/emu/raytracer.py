@@ -49,8 +49,6 @@ def _take(v: Vec, idx: np.ndarray) -> Vec:
     return tuple(c[idx] if np.ndim(c) else c for c in v)
 
 
-
-
 def _rows(idx: np.ndarray) -> np.ndarray | slice:
     """Sorted, distinct indices as a slice when they form one run (views, not gathers)."""
     if len(idx) and idx[-1] - idx[0] + 1 == len(idx):

@@ -8,7 +8,6 @@ from typing import Callable, Sequence
 import numpy as np
 
 from .frame import Frame
-from .memory import reuse_freed_memory
 from .options import EmuOptions
 from .processor import execute
 from .scene import Scene
@@ -69,7 +68,6 @@ def run_program(
     words = list(words)
     decoded: dict = {}  # shared by both passes: each word is decoded once
     execute(words, options, frames, decoded=decoded)  # validation pass
-    reuse_freed_memory()
     render = _renderer(options)
     result = RunResult()
 

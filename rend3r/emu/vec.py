@@ -90,8 +90,8 @@ def _is_identity(q: Quat) -> bool:
 
 
 def _plain(ar: Arith, v: Vec) -> bool:
-    """Whether every component of v is finite and at least the smallest normal number in
-    magnitude.
+    """Whether every component of v is a working-precision value (the arith's dtype, as
+    every arith result is), finite and at least the smallest normal number in magnitude.
 
     Then both rotations by exactly (1, +0, +0, +0) return v itself, bit for bit: every
     product with a zero component of q is a signed zero, every sum adds a signed zero to
@@ -100,4 +100,4 @@ def _plain(ar: Arith, v: Vec) -> bool:
     normal. Zeros, subnormals, infinities and NaN take the full computation (their signs
     and NaNs depend on it).
     """
-    return all(bool((np.isfinite(c) & (np.abs(c) >= ar.tiny)).all()) for c in v)
+    return all(np.asarray(c).dtype == ar.dtype and bool((np.isfinite(c) & (np.abs(c) >= ar.tiny)).all()) for c in v)

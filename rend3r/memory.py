@@ -5,7 +5,10 @@ glibc's default thresholds each of them is mapped from the kernel and unmapped a
 the heap top trimmed), so every temporary pays page faults and zeroing: measured here,
 that doubles the cost of a chain of float32 operations. Raising the mmap and trim
 thresholds lets freed blocks be reused instead. The process then keeps up to
-``TRIM_BYTES`` of freed memory for reuse. Elsewhere than glibc this does nothing.
+``TRIM_BYTES`` of freed memory for reuse, so this is a choice for the program, not for a
+library: the ``rend3r`` command makes it (as do the benchmarks, to measure what it runs);
+code that imports rend3r may call :func:`reuse_freed_memory` itself. Elsewhere than glibc
+this does nothing.
 """
 
 from __future__ import annotations

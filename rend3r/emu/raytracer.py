@@ -15,7 +15,7 @@ import numpy as np
 
 from .arith import Arith
 from .camera import Rays, camera_rays
-from .cull import (FINE, PAIR_CHUNK, Bounds, Rounding, cone_keep, cone_keep_cells, depth_floor, grid_cones, pairs,
+from .cull import (FINE, PAIR_CHUNK, Bounds, Rounding, Tiles, cone_keep, cone_keep_cells, depth_floor, grid_cones, pairs,
                    parallel_keep, parallel_rays, screen_children, screen_tiles, shape_blocks, shape_bounds, subset_tiles,
                    tile_boxes, tile_cones, tile_reduce)
 from .frame import Frame
@@ -283,45 +283,32 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
         floor = depth_floor(bounds, apex, float(cones.dmin.min()), _longest(rays), rnd)
         order = np.argsort(floor, kind="stable")  # front to back: near hits then skip far shapes
     blocks = list(shape_blocks(len(shapes), len(coarse), order))
+    def test(batch, reached):
+        pix, slot = batch
+        if reached is not None:
+            pix, slot = _pick(np.take(floor, slot) <= np.take(reached, pix), pix, slot)
+        if tables is None:
+            s = shapes.take(slot)
+            _, Dh = to_object(ar, s, None, _take(rays.direction, pix))
+            a2 = None
+        else:
+            s = form or Form(shapes.zsign[slot])
+            Dh, a2 = tables.read(slot, pix)
+        one = _one(slot)  # a batch on one shape: its values broadcast
+        sol = solve(ar, s, _take(S_shape, one), Dh, c2_shape[one], rays.tmin, rays.tmax, a2)
+        sqd = squared_distance(ar, dd[pix], sol.t)
+        bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
+        return pix, slot, sqd, sol.t, sol.hit & ~bad, bad
+
     for done, sel in enumerate(blocks):
-        # (cells, nearest hits to filter their pairs by): cells that need no depth check,
-        # then cells whose tile has some pixel nearer than the shape's floor
-        passes = [(np.ones((len(tiles), len(sel)), bool), None)]
         if options.cull:
             ci, si = np.nonzero(cone_keep(cones, apex, None, bounds, sel, rnd))
             fi, si = children[ci].ravel(), np.repeat(si, children.shape[1])
             fi, si = _pick(fi >= 0, fi, si)
             fi, si = _pick(cone_keep_cells(fine_cones, fi, apex, bounds, sel[si], rnd), fi, si)
-            sure = np.ones(len(fi), bool)
-            if near.any:  # depth: a shape whose every hit is farther than a pixel's nearest so far cannot win it
-                reached = near.sqd.copy()
-                in_tiles = reached[tiles.order]
-                low = floor[sel[si]]
-                sure = low <= tile_reduce(tiles, in_tiles, np.minimum)[fi]
-                check = ~sure & (low <= tile_reduce(tiles, in_tiles, np.maximum)[fi])
-            passes = []
-            for cells, nearest in ((sure, None), (check, reached)) if near.any else ((sure, None),):
-                keep = np.zeros((len(tiles), len(sel)), bool)
-                keep[_pick(cells, fi, si)] = True
-                passes.append((keep, nearest))
-
-        def test(batch, reached):
-            pix, slot = batch
-            if reached is not None:
-                pix, slot = _pick(np.take(floor, slot) <= np.take(reached, pix), pix, slot)
-            if tables is None:
-                s = shapes.take(slot)
-                _, Dh = to_object(ar, s, None, _take(rays.direction, pix))
-                a2 = None
-            else:
-                s = form or Form(shapes.zsign[slot])
-                Dh, a2 = tables.read(slot, pix)
-            one = _one(slot)  # a batch on one shape: its values broadcast
-            sol = solve(ar, s, _take(S_shape, one), Dh, c2_shape[one], rays.tmin, rays.tmax, a2)
-            sqd = squared_distance(ar, dd[pix], sol.t)
-            bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
-            return pix, slot, sqd, sol.t, sol.hit & ~bad, bad
-
+            passes = _depth_passes(tiles, len(sel), fi, si, floor[sel[si]], near)
+        else:
+            passes = [(np.ones((len(tiles), len(sel)), bool), None)]
         for keep, reached in passes:
             for batch in pairs(tiles, keep, sel, distinct=True):
                 pix, slot, sqd, t, hit, bad = test(batch, reached)
@@ -333,6 +320,30 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
             progress((done + 1) / len(blocks))
     st.skipped += n_pix * len(shapes) - st.tests
     return near, tables, S_shape
+
+
+def _depth_passes(tiles: Tiles, n_sel: int, fi: np.ndarray, si: np.ndarray, low: np.ndarray,
+                  near: _Nearest) -> list[tuple[np.ndarray, np.ndarray | None]]:
+    """The kept cells (fine tile ``fi``, shape ``si`` of the block, depth floor ``low``) as
+    passes of (keep matrix, nearest hits to check pairs against, or None).
+
+    A shape whose every hit is farther than a pixel's nearest hit so far cannot win it:
+    cells whose floor is at most every nearest hit in their tile are tested unchecked,
+    cells whose floor exceeds some of them pair by pair, cells whose floor exceeds all of
+    them not at all.
+    """
+    def matrix(cells: np.ndarray) -> np.ndarray:
+        keep = np.zeros((len(tiles), n_sel), bool)
+        keep[_pick(cells, fi, si)] = True
+        return keep
+
+    if not near.any:
+        return [(matrix(np.ones(len(fi), bool)), None)]
+    reached = near.sqd.copy()
+    in_tiles = reached[tiles.order]
+    sure = low <= tile_reduce(tiles, in_tiles, np.minimum)[fi]
+    check = ~sure & (low <= tile_reduce(tiles, in_tiles, np.maximum)[fi])
+    return [(matrix(sure), None), (matrix(check), reached)]
 
 
 def shade_hits(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, lights: list[Light], hp: np.ndarray,

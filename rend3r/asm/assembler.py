@@ -1,8 +1,8 @@
 """The assembler: source text to a :class:`Program`, with every diagnostic of the run.
 
 Lines are read one at a time: the fast path (:mod:`.fastpath`) encodes plain
-instruction lines, everything else goes through the Lark grammar (:mod:`.parser`) and is
-checked here against :mod:`rend3r.isa.tables`. Statements run as soon as they are read,
+instruction lines, everything else goes through the Lark grammar (:mod:`.parser`), and
+instructions are encoded by :mod:`.operands`. Statements run as soon as they are read,
 except inside a ``.rept`` block, whose body is collected and then run once per iteration.
 ISA extensions (``ts`` of the hybrid extension, :mod:`rend3r.isa.extensions`) are accepted
 only once enabled, by ``isa_ext=`` or a ``.isa_ext`` directive.
@@ -12,31 +12,18 @@ from __future__ import annotations
 
 import difflib
 import os
-import re
 from dataclasses import dataclass, field
-from fractions import Fraction
 from pathlib import Path
 from typing import Iterable, Mapping
 
 from ..errors import Rend3rError
-from ..isa.encoding import CameraSet, FrameOp, LightSet, ShapeSet, encode
-from ..isa.extensions import EXTENSIONS, table_select_word
-from ..isa.float16 import Rounded, round_literal, shortest_repr
-from ..isa.tables import (
-    F_MNEMONICS,
-    LIGHT_INDEX_LIMIT,
-    MNEMONIC_TABLE,
-    PROPERTIES,
-    SHAPE_INDEX_LIMIT,
-    Property,
-    Table,
-    ValueType,
-    lookup,
-)
+from ..isa.extensions import EXTENSIONS
+from ..isa.tables import F_MNEMONICS, MNEMONIC_TABLE
 from ..isa.targets import TARGETS, Target
 from .diagnostics import ERROR, WARNING, Diagnostic, format_all
 from .expressions import POISON, EvalError, Value, evaluate, fold
 from .fastpath import fast_line
+from .operands import PAIRS, OperandEncoder
 from .parser import (
     Assignment,
     Directive,
@@ -61,13 +48,6 @@ DIRECTIVES = (".include", ".rept", ".endr", ".word", ".isa_ext")
 ISA_EXTENSIONS: Mapping[str, tuple[str, ...]] = EXTENSIONS
 #: what ``isa_ext=`` accepts: one extension name, several, or None
 IsaExt = str | Iterable[str] | None
-_EXTENSION_OF = {m: name for name, ms in ISA_EXTENSIONS.items() for m in ms}
-#: ``ts`` operand -> the table it selects
-TS_TABLES = {"shape": Table.SHAPE, "triangle": Table.TRIANGLE}
-_OPERANDS = {"cam": "PROP, VALUE", "lt": "INDEX, PROP, VALUE", "sp": "INDEX, PROP, PROP2, VALUE, VALUE2"}
-_OPERANDS["tr"] = _OPERANDS["sp"]
-_PAIRS = ("sp", "tr")  # the SE/SD mnemonics, whose table TS selects under the hybrid extension
-_REGISTER = re.compile(r"a(\d+)", re.IGNORECASE)
 
 
 @dataclass
@@ -176,14 +156,11 @@ class Assembler:
         self.scopes: list[list[str]] = []  # constants defined in each running .rept iteration
         self.include_stack: list[Path] = []
         self.statements = 0
-        self.rounded: dict[tuple[int | Fraction, bool], Rounded] = {}  # round_literal cache
         # where the statement being run comes from: file, line, text, context
         self.where: tuple[str, int, str, tuple[str, ...]] = ("", 0, "", ())
         self.mnemonic_names: tuple[str, ...] = MNEMONICS  # the base ones and those of enabled extensions
         self.hybrid = False  # the hybrid extension is enabled (ts; sp/tr checked against the selection)
-        self.selected = Table.SHAPE  # the table the last ts selected (a program starts with the shape table)
-        self.ts_seen = False
-        self.selection_warned = False  # a mismatch was reported since the last ts
+        self.operands = OperandEncoder(self)
         for name in resolve_isa_ext(isa_ext):
             self.enable(name)
 
@@ -236,7 +213,7 @@ class Assembler:
                     entries.append(Emitted(self.address, words, loc, line))
                     self.address += len(words)
                     self.mnemonics.add(mnemonic)
-                    if self.hybrid and mnemonic in _PAIRS:
+                    if self.hybrid and mnemonic in PAIRS:
                         self.check_selection(mnemonic, loc, line, context)
                 else:
                     body.append(_Fixed(mnemonic, words, loc, line))
@@ -294,9 +271,7 @@ class Assembler:
     def run_item(self, item: _Fixed | _Stmt | _Rept, context: tuple[str, ...]) -> None:
         if isinstance(item, _Fixed):
             self.count_statement()
-            self.emit(item.mnemonic, item.words, item.loc, item.text)
-            if self.hybrid and item.mnemonic in _PAIRS:
-                self.check_selection(item.mnemonic, item.loc, item.text, context)
+            self.emit_instruction(item.mnemonic, item.words, item.loc, item.text, context)
         elif isinstance(item, _Rept):
             self.run_rept(item, context)
         else:
@@ -307,6 +282,21 @@ class Assembler:
         self.address += len(words)
         if mnemonic:
             self.mnemonics.add(mnemonic)
+
+    def emit_instruction(self, mnemonic: str, words: tuple[int, ...], loc: SourceLoc, text: str,
+                         context: tuple[str, ...]) -> None:
+        """Emit an instruction's words, checking an sp/tr pair against the ``ts`` selection."""
+        self.emit(mnemonic, words, loc, text)
+        if self.hybrid and mnemonic in PAIRS:
+            self.check_selection(mnemonic, loc, text, context)
+
+    def check_selection(self, mnemonic: str, loc: SourceLoc, text: str, context: tuple[str, ...]) -> None:
+        """Warn, at the mnemonic, when an sp/tr pair writes another table than its own
+        (see :meth:`.OperandEncoder.selection_warning`)."""
+        message = self.operands.selection_warning(mnemonic)
+        if message is not None:
+            self.where = (loc.file, loc.line, text, context)
+            self.warning(message, loc.col, loc.col + len(mnemonic))
 
     def run_rept(self, node: _Rept, context: tuple[str, ...]) -> None:
         self.where = (node.file, node.line, node.text, context)
@@ -336,7 +326,10 @@ class Assembler:
         self.count_statement()
         stmt = item.stmt
         if isinstance(stmt, Instruction):
-            self.instruction(stmt, SourceLoc(item.file, item.line, stmt.col), item.text)
+            words = self.operands.instruction(stmt)
+            if words is not None:
+                loc = SourceLoc(item.file, item.line, stmt.col)
+                self.emit_instruction(stmt.mnemonic.lower(), words, loc, item.text, context)
         elif isinstance(stmt, Assignment):
             self.assignment(stmt, f"{item.file}:{item.line}")
         else:
@@ -405,177 +398,6 @@ class Assembler:
 
     def source(self, node: Operand) -> str:
         return self.where[2][node.col - 1 : node.end - 1]
-
-    # -- instructions ------------------------------------------------------------------
-
-    def instruction(self, stmt: Instruction, loc: SourceLoc, text: str) -> None:
-        m = stmt.mnemonic.lower()
-        ops = stmt.operands
-        if m in F_MNEMONICS:
-            if ops:
-                self.error(f"'{m}' takes no operands", ops[0].col, ops[-1].end)
-                return
-            self.emit(m, encode(FrameOp(F_MNEMONICS[m])), loc, text)
-            return
-        table = MNEMONIC_TABLE.get(m)
-        if table is None:
-            if m in self.mnemonic_names:
-                self.table_select(stmt, loc, text)
-            elif m in _EXTENSION_OF:
-                ext = _EXTENSION_OF[m]
-                self.error(f"unknown mnemonic '{stmt.mnemonic}': it belongs to the {ext} ISA extension; "
-                           f"enable it with '.isa_ext {ext}' in the source (or --isa-ext {ext})", stmt.col, stmt.end)
-            else:
-                close = difflib.get_close_matches(m, self.mnemonic_names, n=1)
-                hint = f"; did you mean '{close[0]}'?" if close else ""
-                self.error(f"unknown mnemonic '{stmt.mnemonic}'{hint}", stmt.col, stmt.end)
-            return
-        expected = _OPERANDS[m].count(",") + 1
-        if len(ops) != expected:
-            end = ops[-1].end if ops else stmt.end
-            self.error(f"'{m}' takes {expected} operands ({_OPERANDS[m]}), got {len(ops)}", stmt.col, end)
-            return
-        if m == "cam":
-            prop = self.prop(table, ops[0])
-            data = self.data(prop, ops[1])
-            if data is not None:
-                self.emit(m, encode(CameraSet(prop.index, data)), loc, text)
-            return
-        index_limit = LIGHT_INDEX_LIMIT if m == "lt" else SHAPE_INDEX_LIMIT
-        index = self.integer(ops[0], f"{table.value} index", 0, index_limit)
-        if index is not None:
-            self.target_index(m, table, index, ops[0])
-        if m == "lt":
-            prop = self.prop(table, ops[1])
-            data = self.data(prop, ops[2])
-            if index is not None and data is not None:
-                self.emit(m, encode(LightSet(index, prop.index, data)), loc, text)
-            return
-        prop, prop2 = self.prop(table, ops[1]), self.prop(table, ops[2])
-        data = self.data(prop, ops[3])
-        data2 = self.data(prop2, ops[4])
-        if prop and prop2 and prop.index == prop2.index and prop.vtype is not ValueType.ZERO:
-            self.warning(
-                f"prop and prop2 are both '{prop.name}': the device writes both and the second value wins",
-                ops[1].col,
-                ops[2].end,
-            )
-        if index is not None and data is not None and data2 is not None:
-            self.emit(m, encode(ShapeSet(index, prop.index, prop2.index, data, data2)), loc, text)
-            if self.hybrid:
-                self.check_selection(m, loc, text, self.where[3])
-
-    def table_select(self, stmt: Instruction, loc: SourceLoc, text: str) -> None:
-        """``ts shape`` / ``ts triangle`` (hybrid extension): one TS word."""
-        ops = stmt.operands
-        if len(ops) != 1:
-            end = ops[-1].end if ops else stmt.end
-            self.error(f"'ts' takes one operand (shape or triangle), got {len(ops)}", stmt.col, end)
-            return
-        node = ops[0]
-        name = node.name.lower() if isinstance(node, Ref) else ""
-        if name not in TS_TABLES:
-            close = difflib.get_close_matches(name, TS_TABLES, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            self.error(f"'ts' selects 'shape' or 'triangle', not '{self.source(node)}'{hint}", node.col, node.end)
-            return
-        self.selected = TS_TABLES[name]
-        self.ts_seen = True
-        self.selection_warned = False
-        self.emit("ts", (table_select_word(self.selected),), loc, text)
-
-    def check_selection(self, mnemonic: str, loc: SourceLoc, text: str, context: tuple[str, ...]) -> None:
-        """Under the hybrid extension, warn (once per ts) when an sp/tr pair writes the
-        table the last ``ts`` selected rather than the one its mnemonic names."""
-        table = MNEMONIC_TABLE[mnemonic]
-        if table is self.selected or self.selection_warned:
-            return
-        self.selection_warned = True
-        self.where = (loc.file, loc.line, text, context)
-        why = "the last 'ts' selected it" if self.ts_seen else "a hybrid program starts with it selected"
-        self.warning(
-            f"'{mnemonic}' writes the {self.selected.value} table here ({why}); "
-            f"put 'ts {table.value}' before it",
-            loc.col,
-            loc.col + len(mnemonic),
-        )
-
-    def target_index(self, m: str, table: Table, index: int, node: Operand) -> None:
-        if self.limits and index >= self.limits[m]:
-            size = self.limits[m]
-            self.warning(
-                f"{table.value} index {index} is beyond {self.target.name}'s {size} {table.value} slots "
-                f"(the device aliases it to {index % size})",
-                node.col,
-                node.end,
-            )
-
-    def prop(self, table: Table, node: Operand) -> Property | None:
-        if not isinstance(node, Ref):
-            self.error(f"expected a {table.value} property name, got '{self.source(node)}'", node.col, node.end)
-            return None
-        prop = lookup(table, node.name)
-        if prop is not None:
-            return prop
-        reg = _REGISTER.fullmatch(node.name)
-        if reg:
-            self.error(f"the {table.value} table has no property {reg.group(1)}", node.col, node.end)
-            return None
-        names = [n for p in PROPERTIES[table] for n in (p.name, *p.extra_names)]
-        close = difflib.get_close_matches(node.name.lower(), names, n=1)
-        hint = f"; did you mean '{close[0]}'?" if close else ""
-        self.error(f"unknown {table.value} property '{node.name}'{hint}", node.col, node.end)
-        return None
-
-    def data(self, prop: Property | None, node: Operand) -> int | None:
-        """The 16 data bits for ``prop`` from ``node``, or None after reporting why not
-        (with no property, only the expression itself is checked)."""
-        v = self.evaluate(node)
-        if v is None or prop is None:
-            return None
-        if v.raw is not None:
-            return v.raw
-        src = self.source(node)
-        if prop.vtype is ValueType.FLOAT16:
-            return self.float_bits(prop, v, node, src)
-        bits = prop.bits if prop.vtype is ValueType.INT else 16
-        what = f"'{prop.name}'" if prop.vtype is ValueType.INT else "the zero property"
-        if not v.is_integer:
-            self.error(f"{what} takes an integer or 0h raw bits, got {src}", node.col, node.end)
-            return None
-        if not 0 <= v.number < (1 << bits):
-            shown = src if src == str(v.number) else f"{src} = {v.number}"
-            self.error(
-                f"{shown} is out of range for {what} ({bits} bits: 0..{(1 << bits) - 1})",
-                node.col,
-                node.end,
-            )
-            return None
-        return v.number
-
-    def float_bits(self, prop: Property, v: Value, node: Operand, src: str) -> int | None:
-        if v.hex_literal:
-            self.warning(
-                f"{src} is the integer {v.number} for float16 property '{prop.name}'; "
-                f"write 0h{src[2:].replace('_', '').lower()} for raw bits",
-                node.col,
-                node.end,
-            )
-        key = (v.number, v.negative_zero)
-        r = self.rounded.get(key)
-        if r is None:
-            r = self.rounded[key] = round_literal(v.number, negative=v.negative_zero)
-        if r.overflow:
-            self.error(f"{src} overflows float16 (magnitude must be below 65520; largest finite is 65504)",
-                       node.col, node.end)
-            return None
-        if r.underflow:
-            self.warning(f"{src} underflows to zero in float16 (smallest subnormal is 2^-24, about 5.96e-08)",
-                         node.col, node.end)
-        elif r.relative_error > 0.01:
-            self.warning(f"{src} rounds to {shortest_repr(r.bits)} in float16 ({r.relative_error:.1%} off)",
-                         node.col, node.end)
-        return r.bits
 
     # -- directives --------------------------------------------------------------------
 

@@ -260,16 +260,18 @@ def depth_floor(b: Bounds, apex: np.ndarray, dmin: float, dmax: float, rnd: Roun
         e = 32.0 * uu * (1.0 + smax / smin)  # transform error, relative (twice section 7's)
         dist = np.linalg.norm(b.center - apex, axis=1)
         s_lo, s_hi = smin * dist * (1.0 - _SLACK) * (1.0 - e), smax * dist * (1.0 + _SLACK) * (1.0 + e)
-        d_lo, d_hi = smin * (1.0 - e), smax * (1.0 + e)  # per unit world direction length
-        b_max = 2.0 * d_hi * s_hi * (1.0 + 4.0 * uu)
-        a_lo, a_hi = 2.0 * d_lo**2 * (1.0 - 4.0 * uu), 2.0 * d_hi**2 * (1.0 + 4.0 * uu)
+        # coefficients per unit |D~| (b scales with it, a2 with its square, c2 not at all)
+        b_max = 2.0 * s_hi * (1.0 + 4.0 * uu)
+        a_lo, a_hi = 2.0 * (1.0 - 4.0 * uu), 2.0 * (1.0 + 4.0 * uu)
         c_lo = 2.0 * (s_lo**2 - 1.0) - 8.0 * uu * (s_hi**2 + 1.0)
         alpha, beta = (1.0 + uu) ** 4, (1.0 - uu) ** 4
         ac = a_lo * c_lo
-        b_min = np.sqrt(np.maximum(0.0, ((1.0 - uu) * ac - tiny) / (1.0 + uu)))  # else disc < 0
+        d_lo = dlo * (1.0 - e)  # |D~| at least
+        b_min = np.sqrt(np.maximum(0.0, ((1.0 - uu) * ac - tiny / d_lo**2) / (1.0 + uu)))  # else disc < 0
         def num(bb):  # B - sqrt(alpha B^2 - beta a c): rises, then falls, with B
             return bb - np.sqrt(np.maximum(0.0, alpha * bb * bb - beta * ac))
-        t_lo = (1.0 - uu) ** 2 * np.minimum(num(b_min), num(b_max)) / a_hi
+        # t~ >= t_unit / |D~|, and |D~| <= smax (1 + e) |d|: t~ >= t_lo / |d|
+        t_lo = (1.0 - uu) ** 2 * np.minimum(num(b_min), num(b_max)) / a_hi / (smax * (1.0 + e))
         floor = (1.0 - uu) ** 6 * (1.0 - 4.0 * uu) * t_lo**2 * (1.0 - _SLACK)
         # the actual t is t_lo / |d| at least; 2 sqrt(tiny) keeps t and t*t clear of underflow
         ok = b.cullable & (dlo >= 2.0**-4) & (e < 0.25) & (c_lo > 0) & (b_min > 0) & (t_lo >= 2.0 * np.sqrt(tiny) * dmax)

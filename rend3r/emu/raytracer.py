@@ -279,7 +279,7 @@ def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: B
         if rays.grid is not None:
             cones, fine_cones = (grid_cones(*rays.grid, t, options.width) for t in (coarse, tiles))
         else:
-            cones, fine_cones = (tile_cones(t, _f64(rays.direction)[t.order]) for t in (coarse, tiles))
+            cones, fine_cones = (tile_cones(t, _f64_rows(rays.direction, t.order)) for t in (coarse, tiles))
         floor = depth_floor(bounds, apex, float(cones.dmin.min()), _longest(rays), rnd)
         order = np.argsort(floor, kind="stable")  # front to back: near hits then skip far shapes
     blocks = list(shape_blocks(len(shapes), len(coarse), order))

@@ -1,25 +1,60 @@
-"""The instruction processor: fetch, decode, execute; ``nf`` hands the scene to a renderer.
+"""The instruction processor: decode and execute a whole program with array operations.
 
 Semantics (paper, section III): ``nr`` clears scene state and the frame buffer, ``nf``
 renders the current scene into a frame, ``lr`` jumps to address 0, ``er`` halts. Running
 past the last word halts as ``er`` does (memory beyond the program is zero, and a zero
 word is ``er``). Device deviations are fields of :class:`EmuOptions`.
+
+Execution has two steps. The control flow is planned first from the control words only
+(nf, lr, halting er, TS, unknown opcodes, a trailing SE), so every error is raised before
+``on_nf`` is first called. Then the data words between control words are applied to the
+scene in bulk (the last write wins; an ``nr`` drops the writes before it) and ``on_nf``
+is called at each nf. Without an lr, execution is one linear pass from address 0; with an
+lr, the pass from ``lr_target`` to its first lr is one period, replayed until the frames
+bound.
 """
 
 from __future__ import annotations
 
+from array import array
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Callable, Sequence
 
+import numpy as np
+
 from ..errors import Rend3rError
-from ..isa import CameraSet, FrameOp, Func, LightSet, ShapeSet, Table, TrailingSE, Unknown, decode_word
-from ..isa.tables import OPCODE, Opcode
-from ..isa.extensions import decode_table_select
+from ..isa import Table, ValueType, by_index
+from ..isa.extensions import TS_CODES, decode_table_select, table_select_word
+from ..isa.tables import (
+    DATA, FUNC, LIGHT_INDEX, OPCODE, PROP, PROP_LIMIT, SD_DATA, SD_DATA2, SE_INDEX_HI, SE_INDEX_LO, SE_PROP2, Field,
+    Func, Opcode,
+)
 from .options import EmuOptions
 from .scene import Scene
 
 #: Called at each ``nf`` with the scene and the frame number (0-based).
 RenderHook = Callable[[Scene, int], None]
+
+_F, _C, _L, _SE = (int(o) for o in (Opcode.F, Opcode.C, Opcode.L, Opcode.SE))
+#: Tables SE/SD pairs can write; a write's table code is its position + 1 (0: the table
+#: in force when the pass started, i.e. no TS before it in the pass).
+_TABLES = tuple(TS_CODES.values())
+_CODE = {t: i + 1 for i, t in enumerate(_TABLES)}
+_TS_WORDS = np.array([table_select_word(t) for t in _TABLES], dtype=np.uint32)
+
+
+def _null_mask(table: Table) -> np.ndarray:
+    """True for the property slots of ``table`` that are null (writing them stores nothing)."""
+    mask = np.zeros(PROP_LIMIT, dtype=bool)
+    mask[[i for i, p in by_index(table).items() if p.vtype is ValueType.ZERO]] = True
+    return mask
+
+
+_CAMERA_NULL, _LIGHT_NULL = _null_mask(Table.CAMERA), _null_mask(Table.LIGHT)
+_SE_NULL = np.stack([_null_mask(t) for t in _TABLES])  # row: table code - 1
+#: Per opcode value: True for C, L and SE (data words; the others are control words).
+_DATA_OPCODE = np.isin(np.arange(1 << OPCODE.width), (_C, _L, _SE))
 
 
 @dataclass(frozen=True)
@@ -31,16 +66,265 @@ class Execution:
     halt: str  # "er", "end" (ran past the last word) or "frames" (the --frames bound)
 
 
-def _decode_at(words: Sequence[int], addr: int):
-    word = words[addr]
-    if OPCODE.get(word) == Opcode.SE:
-        sd = words[addr + 1] if addr + 1 < len(words) else None
-        return decode_word(word, sd), 2
-    return decode_word(word), 1
+def _get(words: np.ndarray, f: Field) -> np.ndarray:
+    """Field ``f`` of every word (``Field.get`` over an array)."""
+    return (words >> f.lo) & ((1 << f.width) - 1)
 
 
 def _where(pc: int) -> str:
     return f"address {pc} (0x{pc:04x})"
+
+
+def _starts(is_se: np.ndarray) -> np.ndarray:
+    """Which words start an instruction when a stream is read from its first word.
+
+    A word after a non-SE-opcode word always starts one; in a run of SE-opcode words the
+    starts alternate from the run's first word; an SE start takes the next word as its SD.
+    Only SE words that follow an SE word need the parity of their place in the run.
+    """
+    se_start = is_se.copy()
+    inner = np.flatnonzero(is_se[1:] & is_se[:-1]) + 1  # a run of k + 1 SE words has k of them, consecutive
+    if len(inner):
+        first = np.ones(len(inner), dtype=bool)
+        first[1:] = np.diff(inner) != 1
+        run_start = np.maximum.accumulate(np.where(first, inner - 1, 0))
+        se_start[inner] = (inner - run_start) % 2 == 0
+    starts = np.ones(len(is_se), dtype=bool)
+    starts[1:] = ~se_start[:-1]
+    return starts
+
+
+@dataclass(frozen=True)
+class _Writes:
+    """Writes of one kind in program order: the writing instruction's address, the light
+    or object index (0 for the camera), the property and the bits."""
+
+    at: np.ndarray
+    index: np.ndarray
+    prop: np.ndarray
+    bits: np.ndarray
+
+    def between(self, lo: int, hi: int) -> _Writes:
+        i, j = np.searchsorted(self.at, (lo, hi))
+        return _Writes(self.at[i:j], self.index[i:j], self.prop[i:j], self.bits[i:j])
+
+    def take(self, keep: np.ndarray) -> _Writes:
+        """The writes where ``keep`` is True."""
+        if keep.all():
+            return self
+        keep = np.flatnonzero(keep)
+        return _Writes(self.at[keep], self.index[keep], self.prop[keep], self.bits[keep])
+
+
+class _Program:
+    """The words (uint32) and their opcodes, with the options that decide their meaning."""
+
+    def __init__(self, words: Sequence[int], options: EmuOptions) -> None:
+        if not isinstance(words, np.ndarray):  # array("I") converts a list fastest
+            words = np.frombuffer(array("I", words), dtype=np.uintc)
+        self.words = words.astype(np.uint32, copy=False)
+        self.op = _get(self.words, OPCODE).astype(np.uint8)
+        self.options = options
+
+
+class _Stream:
+    """The instructions reached linearly from address ``start``, up to ``stop``: the first
+    lr, halting er or error (``kind`` "lr", "er", "error"), or the end ("end")."""
+
+    def __init__(self, prog: _Program, start: int) -> None:
+        self.prog, self.start = prog, start
+        self.starts = start + np.flatnonzero(_starts(prog.op[start:] == _SE))
+        self.ops = prog.op[self.starts]
+        self._pairs: dict[int, tuple[_Writes, _Writes]] = {}
+        self._find_stop(self.starts[~_DATA_OPCODE[self.ops]])  # F words and unknown opcodes
+
+    def _find_stop(self, control: np.ndarray) -> None:
+        """Classify the control words: the nfs before ``stop``, the nrs, the TS words."""
+        prog, n = self.prog, len(self.prog.words)
+        words, frame = prog.words[control], prog.op[control] == _F
+        func = np.where(frame, _get(words, FUNC), -1)
+        nf, lr, self.nr, er = (control[func == int(f)] for f in (Func.NF, Func.LR, Func.NR, Func.ER))
+        if prog.options.er_needs_zero:
+            er = er[(er + 1 >= n) | (prog.words[np.minimum(er + 1, n - 1)] == 0)]
+        ts = np.isin(words, _TS_WORDS) if prog.options.mode == "hybrid" else np.zeros(len(words), dtype=bool)
+        self.ts_at = control[ts]
+        # The table code after k TS words of the stream (k = 0: 0, the pass's entry table).
+        self.ts_codes = np.append(0, 1 + np.argmax(words[ts][:, None] == _TS_WORDS, axis=1))
+        errors = control[~frame & ~ts]
+        last = self.starts[-1:]
+        trailing = last[(last == n - 1) & (prog.op[last] == _SE)]
+        ends = [(int(a[0]), kind) for a, kind in ((lr, "lr"), (er, "er"), (errors, "error"), (trailing, "error"))
+                if len(a)]
+        self.stop, self.kind = min(ends, default=(n, "end"))
+        self.nfs = nf[nf < self.stop]
+
+    def executed_before(self, address: int) -> int:
+        """Instructions of this stream that start before ``address``."""
+        return int(np.searchsorted(self.starts, address))
+
+    def error(self) -> Rend3rError:
+        """The error at ``stop`` (kind "error")."""
+        word = int(self.prog.words[self.stop])
+        if self.prog.op[self.stop] == _SE:
+            return Rend3rError(f"{_where(self.stop)}: SE word 0x{word:08x} is the last word; its SD is missing")
+        hint = ("; it is a TS table-select word (docs/isa-extensions.md): run with --mode hybrid"
+                if decode_table_select(word) is not None else "")
+        return Rend3rError(f"{_where(self.stop)}: unknown opcode 0b{OPCODE.get(word):03b} in word 0x{word:08x}{hint}")
+
+    def outcome(self, frames: int | None, count: int, executed: int) -> Execution | None:
+        """How a pass over this stream ends after ``count`` frames and ``executed``
+        instructions: an Execution, None at an lr (raises the pass's error)."""
+        if frames is not None and len(self.nfs) >= frames - count:
+            return Execution(frames, executed + self.executed_before(self.nfs[frames - count - 1]) + 1, "frames")
+        if self.kind == "error":
+            raise self.error()
+        if self.kind == "lr":
+            return None
+        done = self.executed_before(self.stop) + (self.kind == "er")
+        return Execution(count + len(self.nfs), executed + done, self.kind)
+
+    def table_after(self, entry: int) -> int:
+        """The table code in force at ``stop`` for a pass entered with ``entry``."""
+        return int(self.ts_codes[np.searchsorted(self.ts_at, self.stop)]) or entry
+
+    def _data(self, opcode: int) -> np.ndarray:
+        """Addresses of the instructions with ``opcode`` before ``stop``."""
+        before = self.executed_before(self.stop)
+        return self.starts[:before][self.ops[:before] == opcode]
+
+    @cached_property
+    def camera(self) -> _Writes:
+        return self._word_writes(self._data(_C), _CAMERA_NULL)
+
+    @cached_property
+    def lights(self) -> _Writes:
+        return self._word_writes(self._data(_L), _LIGHT_NULL, LIGHT_INDEX)
+
+    def _word_writes(self, at: np.ndarray, null: np.ndarray, index: Field | None = None) -> _Writes:
+        words = self.prog.words[at]
+        prop = _get(words, PROP)
+        idx = _get(words, index) if index is not None else np.zeros(len(at), dtype=np.uint32)
+        return _Writes(at, idx, prop, _get(words, DATA).astype(np.uint16)).take(~null[prop])
+
+    def pairs(self, entry: int) -> tuple[_Writes, _Writes]:
+        """SE/SD writes before ``stop`` for a pass entered with table code ``entry``, null
+        properties dropped: (to ``scene.objects``, to ``scene.triangles``)."""
+        if entry not in self._pairs:
+            self._pairs[entry] = self._pair_writes(entry)
+        return self._pairs[entry]
+
+    def _pair_writes(self, entry: int) -> tuple[_Writes, _Writes]:
+        """Each pair writes prop then prop2: two writes at the SE's address."""
+        at = self._data(_SE)
+        se, sd = self.prog.words[at], self.prog.words[at + 1]
+        index = (_get(se, SE_INDEX_HI).astype(np.int64) << SE_INDEX_LO.width) | _get(se, SE_INDEX_LO)
+        writes = _Writes(_twice(at), _twice(index), _pair(_get(se, PROP), _get(se, SE_PROP2)),
+                         _pair(_get(sd, SD_DATA), _get(sd, SD_DATA2)).astype(np.uint16))
+        table = self._tables(writes.at, entry)
+        keep = ~_SE_NULL.reshape(-1)[(table - 1) * PROP_LIMIT + writes.prop]
+        if self.prog.options.mode != "hybrid":
+            return writes.take(keep), writes.between(0, 0)  # (0, 0): none
+        triangle = table == _CODE[Table.TRIANGLE]
+        return writes.take(keep & ~triangle), writes.take(keep & triangle)
+
+    def _tables(self, at: np.ndarray, entry: int) -> np.ndarray:
+        """The table code in force at each address of ``at`` in a pass entered with
+        ``entry`` (one 0-d array when the stream has no TS word)."""
+        if not len(self.ts_at):
+            return np.asarray(entry)
+        codes = self.ts_codes[np.searchsorted(self.ts_at, at)]
+        return np.where(codes == 0, entry, codes)
+
+
+def _twice(a: np.ndarray) -> np.ndarray:
+    """Each element twice in a row (one per write of a pair)."""
+    return _pair(a, a)
+
+
+def _pair(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """Interleaved: first[0], second[0], first[1], ..."""
+    out = np.empty((len(first), 2), dtype=np.result_type(first, second))
+    out[:, 0], out[:, 1] = first, second
+    return out.reshape(-1)
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """The validated control flow: the first pass from address 0, and the stream an lr
+    jumps into (None when the first pass does not end at an lr)."""
+
+    execution: Execution
+    first: _Stream
+    loop: _Stream | None
+
+
+def _plan(prog: _Program, frames: int | None) -> _Plan:
+    """Follow the control flow (raising every error) without touching the scene."""
+    first = _Stream(prog, 0)
+    done = first.outcome(frames, 0, 0)
+    if done is not None:
+        return _Plan(done, first, None)
+    if frames is None:
+        raise Rend3rError(
+            f"{_where(first.stop)}: the program loops (lr); pass --frames N to bound how many frames to render")
+    target = prog.options.lr_target
+    loop = first if target == 0 else _Stream(prog, target)
+    count, executed = len(first.nfs), first.executed_before(first.stop) + 1
+    done = loop.outcome(frames, count, executed)
+    if done is not None:
+        return _Plan(done, first, loop)
+    if not len(loop.nfs):
+        raise Rend3rError(f"{_where(loop.stop)}: the program loops (lr) without rendering a frame (no nf in the loop)")
+    periods, last = divmod(frames - count - 1, len(loop.nfs))
+    period = loop.executed_before(loop.stop) + 1
+    total = executed + periods * period + loop.executed_before(loop.nfs[last]) + 1
+    return _Plan(Execution(frames, total, "frames"), first, loop)
+
+
+def _apply(stream: _Stream, lo: int, hi: int, scene: Scene, entry: int) -> None:
+    """Apply the writes of addresses [lo, hi) of ``stream`` (``entry``: the table code in
+    force when the pass started)."""
+    if stream.prog.options.clear_on_nr:
+        i, j = np.searchsorted(stream.nr, (lo, hi))
+        if j > i:
+            scene.clear()
+            lo = int(stream.nr[j - 1]) + 1
+    camera, lights = stream.camera.between(lo, hi), stream.lights.between(lo, hi)
+    if len(camera.at):
+        scene.write_camera(camera.prop, camera.bits)
+    if len(lights.at):
+        scene.write_lights(lights.index, lights.prop, lights.bits)
+    for table, writes in zip((scene.objects, scene.triangles), stream.pairs(entry)):
+        w = writes.between(lo, hi)
+        table.update(w.index, w.prop, w.bits)
+
+
+def _run_pass(stream: _Stream, scene: Scene, on_nf: RenderHook | None, count: int, frames: int | None,
+              entry: int) -> tuple[int, int]:
+    """One pass over ``stream``, calling ``on_nf`` at each nf until the frames bound.
+
+    Returns the frame count and the table code in force at the end of the pass.
+    """
+    lo = stream.start
+    for at in stream.nfs.tolist():
+        _apply(stream, lo, at, scene, entry)
+        if on_nf is not None:
+            on_nf(scene, count)
+        count += 1
+        if count == frames:
+            return count, entry
+        lo = at + 1
+    _apply(stream, lo, stream.stop, scene, entry)
+    return count, stream.table_after(entry)
+
+
+def _replay(plan: _Plan, scene: Scene, on_nf: RenderHook | None, frames: int | None, entry: int) -> None:
+    """Apply the planned passes to ``scene``: the first, then the loop until the frames bound."""
+    stream = plan.first
+    count, entry = _run_pass(stream, scene, on_nf, 0, frames, entry)
+    while stream.kind == "lr" and count != frames and plan.loop is not None:
+        stream = plan.loop
+        count, entry = _run_pass(stream, scene, on_nf, count, frames, entry)
 
 
 def execute(
@@ -49,65 +333,19 @@ def execute(
     frames: int | None = None,
     on_nf: RenderHook | None = None,
     scene: Scene | None = None,
-    decoded: dict[int, tuple[object, int]] | None = None,
 ) -> Execution:
     """Run ``words`` until ``er``, the end, or ``frames`` frames; call ``on_nf`` at each nf.
 
     Raises Rend3rError for an unknown opcode or trailing SE (with its address), for a
-    looping program without a ``frames`` bound, and for a loop that renders nothing.
-    ``decoded`` caches decoded words by address (pass the same dict to run ``words`` again).
+    looping program without a ``frames`` bound, and for a loop that renders nothing, all
+    before ``on_nf`` is first called. ``scene`` (if given) is left as the run left it.
+    Without ``on_nf`` and ``scene`` only the control flow is followed.
     """
     if frames is not None and frames < 1:
         raise Rend3rError(f"--frames must be at least 1, not {frames}")
-    scene = scene if scene is not None else Scene()
-    table = Table.TRIANGLE if options.mode == "raster" else Table.SHAPE
-    decoded = {} if decoded is None else decoded  # address -> (instruction, size); callers may share it
-    pc = count = executed = 0
-    frames_at_last_lr = -1
-    while pc < len(words):
-        if pc not in decoded:
-            decoded[pc] = _decode_at(words, pc)
-        ins, size = decoded[pc]
-        executed += 1
-        if isinstance(ins, Unknown):
-            selected = decode_table_select(ins.word) if options.mode == "hybrid" else None
-            if selected is None:
-                hint = ("; it is a TS table-select word (docs/isa-extensions.md): run with --mode hybrid"
-                        if decode_table_select(ins.word) is not None else "")
-                raise Rend3rError(f"{_where(pc)}: unknown opcode 0b{OPCODE.get(ins.word):03b} in word 0x{ins.word:08x}{hint}")
-            table = selected
-            pc += size
-            continue
-        if isinstance(ins, TrailingSE):
-            raise Rend3rError(f"{_where(pc)}: SE word 0x{ins.word:08x} is the last word; its SD is missing")
-        pc += size
-        if isinstance(ins, CameraSet):
-            scene.set_camera(ins)
-        elif isinstance(ins, LightSet):
-            scene.set_light(ins)
-        elif isinstance(ins, ShapeSet):
-            scene.set_object(ins, table, scene.triangles if options.mode == "hybrid" and table is Table.TRIANGLE else None)
-        elif isinstance(ins, FrameOp):
-            if ins.func is Func.ER:
-                if not options.er_needs_zero or pc >= len(words) or words[pc] == 0:
-                    return Execution(count, executed, "er")
-                continue  # the device skips an er whose next word is not zero
-            if ins.func is Func.NR:
-                if options.clear_on_nr:
-                    scene.clear()
-            elif ins.func is Func.NF:
-                if on_nf is not None:
-                    on_nf(scene, count)
-                count += 1
-                if frames is not None and count >= frames:
-                    return Execution(count, executed, "frames")
-            else:  # LR
-                if frames is None:
-                    raise Rend3rError(
-                        f"{_where(pc - size)}: the program loops (lr); pass --frames N to bound how many frames to render"
-                    )
-                if count == frames_at_last_lr:
-                    raise Rend3rError(f"{_where(pc - size)}: the program loops (lr) without rendering a frame (no nf in the loop)")
-                frames_at_last_lr = count
-                pc = options.lr_target
-    return Execution(count, executed, "end")
+    prog = _Program(words, options)
+    plan = _plan(prog, frames)
+    if on_nf is not None or scene is not None:
+        entry = _CODE[Table.TRIANGLE if options.mode == "raster" else Table.SHAPE]
+        _replay(plan, scene if scene is not None else Scene(), on_nf, frames, entry)
+    return plan.execution

@@ -33,7 +33,7 @@ from .options import EmuOptions
 from .raster_clip import ClipPlanes, clip_triangles
 from .raster_cover import Spans, fragments, spans
 from .raster_shade import flat_colours
-from .scene import Scene, prop_index
+from .scene import ObjectTable, Scene, prop_index
 from .stats import FrameStats
 from .vec import Quat, rotate_inverse
 
@@ -272,7 +272,7 @@ _VERTEX_PROPS = ("x1", "y1", "z1", "x2", "y2", "z2", "x3", "y3", "z3")
 
 
 def triangles_from_scene(
-    scene: Scene, ar: Arith, next_triangle: bool = False, store: dict[int, dict[int, int]] | None = None
+    scene: Scene, ar: Arith, next_triangle: bool = False, store: ObjectTable | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every triangle the program wrote, in index order: (indices, vertices (N,3,3), colours).
 
@@ -283,13 +283,12 @@ def triangles_from_scene(
     p = [prop_index(Table.TRIANGLE, n) for n in _VERTEX_PROPS]
     col = prop_index(Table.TRIANGLE, "col")
     store = scene.objects if store is None else store
-    rows = sorted(store.items())
+    index, values = store.index.copy(), store.values
     if next_triangle:
-        rows = [(i, store.get(i + 1, {})) for i, _ in rows]
-    index = np.fromiter((i for i, _ in rows), dtype=np.int64, count=len(rows))
-    bits = np.array([[props.get(k, 0) for k in p] for _, props in rows], dtype=np.uint16).reshape(-1, 3, 3)
-    colours = np.fromiter((props.get(col, 0) for _, props in rows), dtype=np.uint16, count=len(rows))
-    return index, ar.from_bits(bits), colours
+        at = np.minimum(np.searchsorted(index, index + 1), max(len(index) - 1, 0))
+        written = index[at] == index + 1
+        values = np.where(written[:, None], values[at], np.uint16(0))
+    return index, ar.from_bits(values[:, p].reshape(-1, 3, 3)), values[:, col].copy()
 
 
 def view_from_scene(scene: Scene, ar: Arith) -> RasterView:

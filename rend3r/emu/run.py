@@ -59,15 +59,13 @@ def run_program(
 ) -> RunResult:
     """Execute ``words``, rendering a frame at each ``nf`` (up to ``frames`` frames).
 
-    The program is first run without rendering, so decoding errors and unbounded loops are
-    reported before any time is spent on frames. ``keep_frames=False`` leaves
-    ``result.frames`` empty (use ``on_frame`` to consume frames as they come).
+    The processor validates the control flow before the first frame, so decoding errors
+    and unbounded loops are reported before any time is spent on frames.
+    ``keep_frames=False`` leaves ``result.frames`` empty (use ``on_frame`` to consume
+    frames as they come).
     ``on_scene`` sees each frame's scene (pixel traces use it).
     """
     options = options or EmuOptions()
-    words = list(words)
-    decoded: dict = {}  # shared by both passes: each word is decoded once
-    execute(words, options, frames, decoded=decoded)  # validation pass
     render = _renderer(options)
     result = RunResult()
 
@@ -90,6 +88,6 @@ def run_program(
         if on_frame is not None:
             on_frame(frame)
 
-    ex = execute(words, options, frames, on_nf, decoded=decoded)
+    ex = execute(words, options, frames, on_nf)
     result.stats.instructions, result.stats.halt = ex.instructions, ex.halt
     return result

@@ -1,15 +1,20 @@
-"""Scene state as the instruction processor leaves it: sparse, float16 bits as stored.
+"""Scene state as the instruction processor leaves it: float16 bits as stored.
 
-Only what a program touched is held: a shape index near 2**19 costs one dict entry.
-Values are the raw 16-bit words of the instructions; the renderer interprets them with
-the property tables (never hard-coded numbers).
+Shapes and triangles are columnar (:class:`ObjectTable`): the sorted indices a program
+touched and one row of 32 property words per index, so renderers read tens of thousands
+of shapes with array operations. The camera and lights (at most 32 and 64 x 32 words) are
+dicts. Values are the raw 16-bit words of the instructions; the renderers interpret them
+with the property tables (never hard-coded numbers).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..isa import CameraSet, LightSet, ShapeSet, Table, ValueType, by_index, lookup
+import numpy as np
+
+from ..isa import Table, lookup
+from ..isa.tables import LIGHT_INDEX_LIMIT, PROP_LIMIT
 
 
 def prop_index(table: Table, name: str) -> int:
@@ -20,17 +25,66 @@ def prop_index(table: Table, name: str) -> int:
     return prop.index
 
 
-#: Per table, the null properties (``zero``): writing them stores nothing.
-_NULL_PROPS = {t: frozenset(i for i, p in by_index(t).items() if p.vtype is ValueType.ZERO) for t in Table}
+def _last(cell: np.ndarray, cells: int) -> np.ndarray:
+    """For writes to ``cell`` (each in ``range(cells)``) in program order: True for the
+    last write to each cell."""
+    position = np.arange(len(cell), dtype=np.int32 if len(cell) < 2**31 else np.int64)
+    last = np.full(cells, -1, dtype=position.dtype)
+    np.maximum.at(last, cell, position)
+    return last[cell] == position
 
 
-def _writes(table: Table, prop: int) -> bool:
-    return prop not in _NULL_PROPS[table]
+class ObjectTable:
+    """Shapes or triangles: ``index`` (sorted unique int64: every index written since the
+    last clear) and ``values`` ((n, 32) uint16: property words, 0 where never written)."""
+
+    def __init__(self) -> None:
+        self.clear()
+
+    def clear(self) -> None:
+        self.index = np.empty(0, dtype=np.int64)
+        self.values = np.zeros((0, PROP_LIMIT), dtype=np.uint16)
+
+    def __len__(self) -> int:
+        return len(self.index)
+
+    def update(self, index: np.ndarray, prop: np.ndarray, value: np.ndarray) -> None:
+        """Write ``value`` to ``(index, prop)`` in array order (the last write wins); every
+        index given is touched, so it gets a row."""
+        if not len(index):
+            return
+        cell = self._rows(index) * PROP_LIMIT + prop
+        last = _last(cell, self.values.size)
+        self.values.reshape(-1)[cell[last]] = value[last]
+
+    def _rows(self, index: np.ndarray) -> np.ndarray:
+        """The row of each element of ``index``, adding zero rows for new indices.
+
+        A dense map over the index range (no sort): SE indices have 19 bits.
+        """
+        slot = np.zeros(max(int(index.max()), int(self.index.max(initial=-1))) + 1, dtype=np.int64)
+        slot[self.index] = 1
+        slot[index] = 1
+        merged = np.flatnonzero(slot)
+        slot[merged] = np.arange(len(merged))
+        if len(merged) > len(self.index):
+            values = np.zeros((len(merged), PROP_LIMIT), dtype=np.uint16)
+            values[slot[self.index]] = self.values
+            self.index, self.values = merged, values
+        return slot[index]
+
+    def row(self, index: int) -> dict[int, int]:
+        """The non-zero property words of ``index`` (KeyError if it was never written)."""
+        at = int(np.searchsorted(self.index, index))
+        if at == len(self.index) or self.index[at] != index:
+            raise KeyError(index)
+        return {prop: int(v) for prop, v in enumerate(self.values[at]) if v}
 
 
 @dataclass
 class Scene:
-    """Camera, lights and shapes (or triangles): ``{index: {prop: bits}}``.
+    """Camera ``{prop: bits}``, lights ``{index: {prop: bits}}`` (a key means written),
+    and the object tables.
 
     ``objects`` holds what SE/SD pairs write in raytrace and raster mode; in hybrid mode
     (``docs/isa-extensions.md``) pairs aimed at the triangle table go to ``triangles``.
@@ -38,8 +92,8 @@ class Scene:
 
     camera: dict[int, int] = field(default_factory=dict)
     lights: dict[int, dict[int, int]] = field(default_factory=dict)
-    objects: dict[int, dict[int, int]] = field(default_factory=dict)
-    triangles: dict[int, dict[int, int]] = field(default_factory=dict)
+    objects: ObjectTable = field(default_factory=ObjectTable)
+    triangles: ObjectTable = field(default_factory=ObjectTable)
 
     def clear(self) -> None:
         self.camera.clear()
@@ -47,24 +101,17 @@ class Scene:
         self.objects.clear()
         self.triangles.clear()
 
-    def set_camera(self, ins: CameraSet) -> None:
-        if _writes(Table.CAMERA, ins.prop):
-            self.camera[ins.prop] = ins.data
+    def write_camera(self, prop: np.ndarray, data: np.ndarray) -> None:
+        """C writes in program order, null properties dropped (the last write wins)."""
+        last = _last(prop, PROP_LIMIT)
+        self.camera.update(zip(prop[last].tolist(), data[last].tolist()))
 
-    def set_light(self, ins: LightSet) -> None:
-        if _writes(Table.LIGHT, ins.prop):
-            self.lights.setdefault(ins.index, {})[ins.prop] = ins.data
-
-    def set_object(self, ins: ShapeSet, table: Table, store: dict[int, dict[int, int]] | None = None) -> None:
-        """SE/SD: prop then prop2 (so prop2 wins when both name the same property).
-
-        ``store`` is ``objects`` unless given (hybrid mode's ``triangles``).
-        """
-        target = self.objects if store is None else store
-        null = _NULL_PROPS[table]
-        for prop, data in ((ins.prop, ins.data), (ins.prop2, ins.data2)):
-            if prop not in null:
-                target.setdefault(ins.index, {})[prop] = data
+    def write_lights(self, index: np.ndarray, prop: np.ndarray, data: np.ndarray) -> None:
+        """L writes in program order, null properties dropped (the last write wins); the
+        loop runs once per distinct (light, property), not per word."""
+        last = _last(index.astype(np.int64) * PROP_LIMIT + prop, LIGHT_INDEX_LIMIT * PROP_LIMIT)
+        for light, p, bits in zip(index[last].tolist(), prop[last].tolist(), data[last].tolist()):
+            self.lights.setdefault(light, {})[p] = bits
 
     def camera_bits(self, name: str, default: int = 0) -> int:
         return self.camera.get(prop_index(Table.CAMERA, name), default)

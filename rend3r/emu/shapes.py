@@ -57,13 +57,12 @@ def shapes_from_scene(scene: Scene, arith: Arith) -> Shapes:
     """Collect the shapes whose type is sphere, cylinder or cone (others are off)."""
     p = {n: prop_index(Table.SHAPE, n) for n in (
         "xloc", "yloc", "zloc", "rrot", "irot", "jrot", "krot", "xscl", "yscl", "zscl", "col", "type")}
-    rows = sorted((i, props) for i, props in scene.objects.items() if props.get(p["type"], 0) & _TYPE.value_mask in NORMAL_FORMS)
-    n = len(rows)
-    names = list(p)
-    table = np.array([[props.get(p[name], 0) for name in names] for _, props in rows], dtype=np.uint16).reshape(n, len(names))
+    objects = scene.objects
+    on = np.isin(objects.values[:, p["type"]] & _TYPE.value_mask, list(NORMAL_FORMS))
+    table = objects.values[on]
 
     def bits(name: str) -> np.ndarray:
-        return table[:, names.index(name)].copy()
+        return table[:, p[name]].copy()
 
     kind = bits("type") & _TYPE.value_mask
     rot = [bits(n) for n in ("rrot", "irot", "jrot", "krot")]
@@ -71,7 +70,7 @@ def shapes_from_scene(scene: Scene, arith: Arith) -> Shapes:
     rot[0] = np.where(unset, np.uint16(_ONE), rot[0])
     forms = np.array([NORMAL_FORMS.get(int(k), (0.0, 0.0)) for k in range(_TYPE.value_mask + 1)])
     return Shapes(
-        index=np.fromiter((i for i, _ in rows), dtype=np.int64, count=n),
+        index=objects.index[on],
         kind=kind.astype(np.uint8),
         loc=tuple(arith.from_bits(bits(a)) for a in ("xloc", "yloc", "zloc")),
         rot=tuple(arith.from_bits(b) for b in rot),

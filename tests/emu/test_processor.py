@@ -77,7 +77,7 @@ def test_se_takes_the_next_word_as_sd_even_when_it_is_zero_or_looks_like_er():
     scene = Scene()
     ex = execute(words, SPEC, scene=scene)
     assert ex.frames == 1
-    assert scene.objects == {5: {prop_index(Table.SHAPE, "type"): 0}}
+    assert scene.objects.index.tolist() == [5] and scene.objects.row(5) == {}  # touched, type 0
 
 
 def test_prop2_wins_when_both_name_the_same_property_and_zero_prop_writes_nothing():
@@ -85,13 +85,13 @@ def test_prop2_wins_when_both_name_the_same_property_and_zero_prop_writes_nothin
     words = Prog().words + list(encode(ShapeSet(3, x, x, f16(1.0), f16(2.0)))) + list(encode(ShapeSet(4, 0, 0, 7, 7)))
     scene = Scene()
     execute(words, SPEC, scene=scene)
-    assert scene.objects == {3: {x: f16(2.0)}}
+    assert scene.objects.index.tolist() == [3] and scene.objects.row(3) == {x: f16(2.0)}
 
 
 def test_scene_is_sparse_for_huge_indices():
     scene = Scene()
     execute(Prog().sphere((1 << 19) - 1).words, SPEC, scene=scene)
-    assert list(scene.objects) == [(1 << 19) - 1]
+    assert scene.objects.index.tolist() == [(1 << 19) - 1]
 
 
 def test_frames_bound_must_be_positive():

@@ -7,7 +7,7 @@ Both return :class:`Rays` in working precision, one ray per pixel in row-major o
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -25,14 +25,33 @@ VIEW_WIDTH, VIEW_HEIGHT = 10.0, 7.5
 
 @dataclass(frozen=True)
 class Rays:
-    """Rays from one origin: ``origin + t * direction`` accepted for ``tmin <= t <= tmax``."""
+    """Rays from one origin: ``origin + t * direction`` accepted for ``tmin <= t <= tmax``.
+
+    Pixel (x, y) looks along (xs[x], ys[y], z), turned by ``rotation`` (q * (0, v) *
+    conj(q), in working precision) when the camera has one.
+    """
 
     origin: Vec  # three 0-d arrays
-    direction: Vec  # three (pixels,) arrays
+    xs: np.ndarray  # (width,)
+    ys: np.ndarray  # (height,)
+    z: np.ndarray  # 0-d
+    rotation: Quat | None
     tmin: np.ndarray
     tmax: np.ndarray
-    #: When the directions are exactly (x[column], y[row], z): (x, y, z); else None.
-    grid: Vec | None = None
+    arith: Arith
+
+    @property
+    def grid(self) -> Vec | None:
+        """(xs, ys, z) when the directions are exactly (x[column], y[row], z), else None."""
+        return (self.xs, self.ys, self.z) if self.rotation is None else None
+
+    @cached_property
+    def direction(self) -> Vec:
+        """Every pixel's direction, row-major: three (pixels,) arrays."""
+        shape = (len(self.ys), len(self.xs))
+        cam = (np.broadcast_to(self.xs[None, :], shape).ravel(), np.broadcast_to(self.ys[:, None], shape).ravel(),
+               np.full(shape[0] * shape[1], self.z, dtype=self.arith.dtype))
+        return cam if self.rotation is None else rotate(self.arith, self.rotation, cam)
 
 
 def camera_rays(scene: Scene, options: EmuOptions, arith: Arith) -> Rays:
@@ -60,11 +79,7 @@ def _device_rays(origin: Vec, width: int, height: int, arith: Arith) -> Rays:
     """Direction (x0 + x*step, y0 + y*step, -1), unnormalised; row 0 is world y = -3.74."""
     xs = _device_axis(arith, DEVICE_X0, width)
     ys = _device_axis(arith, DEVICE_Y0, height)
-    dx = np.broadcast_to(xs[None, :], (height, width)).ravel()
-    dy = np.broadcast_to(ys[:, None], (height, width)).ravel()
-    z = arith.from_bits(DEVICE_Z)
-    dz = np.full(width * height, z, dtype=arith.dtype)
-    return Rays(origin, (dx, dy, dz), arith.const(0.0), arith.const(np.inf), (xs, ys, z))
+    return Rays(origin, xs, ys, arith.from_bits(DEVICE_Z), None, arith.const(0.0), arith.const(np.inf), arith)
 
 
 def camera_value(scene: Scene, name: str, arith: Arith, default: float) -> np.ndarray:
@@ -103,15 +118,6 @@ def _spec_rays(scene: Scene, origin: Vec, width: int, height: int, arith: Arith)
     ux, uy = _viewport_axes(arith, width, height)
     cx = arith.mul(arith.mul(ux, hfov), near)
     cy = arith.mul(arith.mul(uy, vfov), near)
-    shape = (height, width)
-    cam = (
-        np.broadcast_to(cx[None, :], shape).ravel(),
-        np.broadcast_to(cy[:, None], shape).ravel(),
-        np.full(width * height, arith.neg(near), dtype=arith.dtype),
-    )
-    q = camera_quaternion(scene, arith)
-    direction = cam if q is None else rotate(arith, q, cam)
     far = arith.from_bits(scene.camera_bits("fclip"))
     tmax = arith.const(np.inf) if float(far) == 0.0 else arith.div(far, near)
-    grid = (cx, cy, arith.neg(near)) if q is None else None
-    return Rays(origin, direction, arith.const(1.0), tmax, grid)
+    return Rays(origin, cx, cy, arith.neg(near), camera_quaternion(scene, arith), arith.const(1.0), tmax, arith)

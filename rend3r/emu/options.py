@@ -30,7 +30,6 @@ class EmuOptions:
     camera: CameraModel = "spec"  # "device": fixed rays of the original hardware
     lr_target: int = 0  # address `lr` jumps to (the device jumps to 1)
     clear_on_nr: bool = True  # `nr` clears scene state and frame buffer (the device does not)
-    cull: bool = True  # skip shape tests that provably cannot change a pixel
     depth: DepthRule = "zbuffer"  # raster mode: z-buffer, painter's order, or index order (device)
     light_model: LightModel = "spec"  # "device": light 0 only, directional, colour/intensity ignored
     intensity_fixed: bool = False  # the device's 13-bit converter of the light factor
@@ -43,6 +42,7 @@ class EmuOptions:
     raster_rules: Literal["spec", "device"] = "spec"
     raster_column_offset: int = 0
     raster_next_triangle: bool = False
+    jobs: int = 0  # threads rendering a frame (0: every core); the image does not depend on it
 
     @property
     def arith(self) -> Arith:

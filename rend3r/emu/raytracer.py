@@ -1,423 +1,388 @@
 """The raytracer: nearest hit per pixel, diffuse lighting, shadow rays, NaN accounting.
 
-Work is done on (pixel, shape) pairs in batches; :mod:`.cull` drops pairs that provably
-cannot change a pixel. Colour arithmetic (after the float16 datapath): see
-``docs/emulator.md``.
+The frame is rendered in bands of rows, so memory stays bounded at any size; each band's
+pixels are split into chunks that threads render with the compiled kernels of
+``csrc/datapath.inc`` (``--jobs``; every pixel is computed the same way whatever the
+split, so the image does not depend on it). Per band:
+
+1. primary directions and their per-face (u, v) boxes (``directions``);
+2. a grid of the shapes each primary ray must test, front to back by depth floor
+   (:mod:`.grids`, :mod:`.bounds`);
+3. the nearest hit of every pixel, its hit point and normal (``nearest``);
+4. per light, a grid of the shapes each shadow ray must test, then the light's colour
+   with its shadow rays (``light_pass``);
+5. colours, depth and provenance (``finish``).
+
+``docs/emulator.md`` sections 4-7 give the order of operations and why the grids never
+change a pixel; :mod:`.reference` is the plain renderer the tests compare with.
 """
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
+from ctypes import byref, pointer
 from dataclasses import dataclass
+from functools import lru_cache
 from time import perf_counter
-from typing import Callable, Iterator
+from typing import Callable
 
 import numpy as np
 
+from . import bounds, grids, native
 from .arith import Arith
-from .camera import Rays, camera_rays
-from .cull import (FINE, PAIR_CHUNK, Bounds, Rounding, Tiles, cone_keep, cone_keep_cells, depth_floor, grid_cones, pairs,
-                   parallel_keep, parallel_rays, screen_children, screen_tiles, shape_blocks, shape_bounds, subset_tiles,
-                   tile_boxes, tile_cones, tile_reduce)
+from .camera import camera_rays
 from .frame import Frame
-from .lighting import Recorder, diffuse
 from .lights import POINT, Light, lights_from_scene
 from .options import EmuOptions
 from .scene import Scene
-from .shapes import (Form, Shapes, direction_term, origin_term, shapes_from_scene, solve, squared_distance, surface,
-                     to_object, transform_classes, uniform_form)
+from .shapes import SPHERE, Shapes, shapes_from_scene
 from .stats import FrameStats
-from .vec import Vec, dot
 
 Progress = Callable[[float], None]
-_NONE = np.iinfo(np.int64).max
+#: Pixels per band: bounds the per-pixel working arrays (about 100 bytes per pixel).
+BAND_PIXELS = 1 << 20
+#: Smallest chunk of pixels handed to a thread.
+MIN_CHUNK = 1 << 12
+_CHANNELS = ((11, 31), (5, 63), (0, 31))  # RGB565: (shift, largest value) per channel
 
 
-def _f64(v: Vec) -> np.ndarray:
-    """(n, 3) float64 view of a vector for culling geometry."""
-    return np.stack(np.broadcast_arrays(*[np.atleast_1d(np.asarray(c, np.float64)) for c in v]), axis=-1)
+def available_cores() -> int:
+    """Cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
 
 
-def _f64_rows(v: Vec, idx: np.ndarray) -> np.ndarray:
-    """(len(idx), 3) float64 rows of a vector's entries ``idx`` (components may be scalars)."""
-    out = np.empty((len(idx), 3))
-    for k, c in enumerate(v):
-        out[:, k] = np.take(c, idx) if np.ndim(c) else c
-    return out
+@lru_cache(maxsize=4)
+def _pool(jobs: int) -> ThreadPoolExecutor:
+    return ThreadPoolExecutor(max_workers=jobs, thread_name_prefix="rend3r")
 
 
-def _take(v: Vec, idx: np.ndarray) -> Vec:
-    return tuple(c[idx] if np.ndim(c) else c for c in v)
+@dataclass
+class _Frame:
+    """What every band of a frame shares (the arrays back the kernels' pointers)."""
+
+    ar: Arith
+    dtype: np.dtype
+    cam: np.ndarray
+    xs: np.ndarray
+    ys: np.ndarray
+    rotated: bool
+    sf: np.ndarray
+    si: np.ndarray
+    index: np.ndarray
+    bnd: np.ndarray
+    bounded: np.ndarray
+    lights: list[Light]
+    light_rows: np.ndarray
+    jobs: int
+    shapes: native.Shapes
+
+    @property
+    def fp16(self) -> bool:
+        return self.ar.precision == "fp16"
+
+    def kernel(self, name: str):
+        """The compiled kernel ``name`` for this frame's precision."""
+        return native.kernel(name, self.ar.precision, self.ar.ftz)
 
 
-def _rows(idx: np.ndarray) -> np.ndarray | slice:
-    """Sorted, distinct indices as a slice when they form one run (views, not gathers)."""
-    if len(idx) and idx[-1] - idx[0] + 1 == len(idx):
-        return slice(int(idx[0]), int(idx[-1]) + 1)
-    return idx
-
-
-def _one(slots: np.ndarray) -> np.ndarray | int:
-    """Shape positions, or the one position when all are the same (its values then enter
-    as scalars, which broadcast)."""
-    if len(slots) and (slots.strides == (0,) or (slots == slots[0]).all()):
-        return int(slots[0])
-    return slots
-
-
-def _pick(mask: np.ndarray, *arrays: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Each array's entries where ``mask`` holds: one index pass, then gathers (boolean
-    indexing is several times slower on irregular masks). A broadcast of one value stays
-    a broadcast."""
-    idx = np.flatnonzero(mask)
-    return tuple(np.broadcast_to(a[0], idx.shape) if a.strides == (0,) and len(a) else np.take(a, idx)
-                 for a in arrays)
-
-
-class _Nearest:
-    """Running nearest hit per pixel: smallest squared distance, ties to the lower index."""
-
-    def __init__(self, n: int, dtype: type) -> None:
-        self.sqd = np.full(n, np.inf, dtype=dtype)
-        self.slot = np.full(n, _NONE, dtype=np.int64)
-        self.t = np.full(n, np.nan, dtype=dtype)  # the winner's t
-        self.any = False  # whether any hit was merged
-
-    def update(self, pix: np.ndarray, slot: np.ndarray, sqd: np.ndarray, t: np.ndarray | None = None,
-               distinct: bool = False, hit: np.ndarray | None = None) -> None:
-        """Merge the pairs (those where ``hit`` holds, if given) as hits.
-
-        ``distinct``: no pixel occurs twice in ``pix``, which allows a cheaper merge.
-        """
-        extra = () if t is None else (t,)
-        if distinct:
-            if not self.any:  # every hit beats no hit
-                better = np.ones(len(pix), bool) if hit is None else hit
-            else:
-                now = np.take(self.sqd, pix)
-                better = (sqd < now) | ((sqd == now) & (slot < np.take(self.slot, pix)))
-                if hit is not None:
-                    better &= hit
-            won, sqd, slot, *extra = _pick(better, pix, sqd, slot, *extra)
-            self.sqd[won], self.slot[won] = sqd, slot
-            if t is not None:
-                self.t[won] = extra[0]
-            self.any |= len(won) > 0
-            return
-        if hit is not None:
-            pix, slot, sqd, *extra = _pick(hit, pix, slot, sqd, *extra)
-        self.any |= len(pix) > 0
-        before = np.take(self.sqd, pix)
-        np.minimum.at(self.sqd, pix, sqd)
-        now = np.take(self.sqd, pix)
-        self.slot[_pick(now < before, pix)[0]] = _NONE
-        tie = sqd == now
-        np.minimum.at(self.slot, *_pick(tie, pix, slot))
-        if t is not None:
-            won = tie & (np.take(self.slot, pix) == slot)
-            won_pix, won_t = _pick(won, pix, extra[0])
-            self.t[won_pix] = won_t
-
-
-def render_frame(
-    scene: Scene, options: EmuOptions, number: int = 0, progress: Progress | None = None
-) -> tuple[Frame, FrameStats]:
+def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
+                 progress: Progress | None = None) -> tuple[Frame, FrameStats]:
     """Render the scene as the raytracer sees it; returns the frame and its stats."""
     start = perf_counter()
-    ar = options.arith
+    fr = set_up(scene, options)
     w, h, n_pix = options.width, options.height, options.pixels
-    rays = camera_rays(scene, options, ar)
-    shapes = shapes_from_scene(scene, ar)
-    lights = lights_from_scene(scene, ar, options.light_model)
-    st = FrameStats(number=number, pixels=n_pix, shapes=len(shapes), lights=len(lights), rays=n_pix)
+    st = FrameStats(number=number, pixels=n_pix, shapes=len(fr.sf), lights=len(fr.lights), rays=n_pix)
     rgb = np.full(n_pix, options.background, dtype=np.uint16)
     depth = np.full(n_pix, np.inf, dtype=np.float32)
     prov = np.full(n_pix, -1, dtype=np.int32)
-    nan_pixel = np.zeros(n_pix, dtype=bool)
-    if len(shapes):
-        bounds = shape_bounds(shapes)
-        dd = _squared_lengths(ar, rays)
-        near, tables, S_shape = _primary(ar, options, rays, dd, shapes, bounds, st, nan_pixel, progress)
-        hp = np.flatnonzero(near.slot != _NONE)
-        slot = near.slot[hp]
-
-        def hit_surface(job):
-            lo, hi = job
-            px, sl = _rows(hp[lo:hi]), _one(slot[lo:hi])
-            D = tuple(c[px] for c in rays.direction)
-            if not lights:  # unlit: whether the point is finite is all that matters
-                point, _ = surface(ar, None, None, None, near.t[px], rays.origin, D, normals=False)
-                return np.isfinite(point[0]) & np.isfinite(point[1]) & np.isfinite(point[2])
-            if tables is None:
-                s = shapes.take(sl)
-                _, Dh = to_object(ar, s, None, D)
-            else:  # one transform class: its parameters broadcast, nothing to gather per hit
-                s = shapes.take(int(tables.first[0]) if tables.single else sl)
-                Dh, _ = tables.read(sl, px)
-            return surface(ar, s, _take(S_shape, sl), Dh, near.t[px], rays.origin, D)
-
-        parts = [hit_surface((lo, lo + PAIR_CHUNK)) for lo in range(0, len(hp), PAIR_CHUNK)]
-        if lights:
-            empty = (np.zeros(0, ar.dtype),) * 3
-            point, normal = (tuple(np.concatenate([p[k][a] for p in parts]) if parts else empty[a] for a in range(3))
-                             for k in range(2))
-            color, bad = shade_hits(ar, options, shapes, bounds, lights, hp, slot, point, normal, st, nan_pixel)
-        else:  # unlit: the shape's colour where the hit point is finite
-            color, bad = shapes.color[slot], ~np.concatenate(parts) if parts else np.zeros(0, bool)
-        if bad.any():
-            nan_pixel[hp[bad]] = True
-            hp, slot, color = hp[~bad], slot[~bad], color[~bad]
-        st.hits = len(hp)
-        hp = _rows(hp)
-        rgb[hp] = color
-        prov[hp] = shapes.index[slot]
-        np.copyto(depth, np.sqrt(near.sqd, dtype=np.float64), where=prov >= 0)
-    st.nan_rays = int(nan_pixel.sum())
+    if len(fr.sf):
+        rows = max(1, BAND_PIXELS // w)
+        for row0 in range(0, h, rows):
+            row1 = min(h, row0 + rows)
+            _band(fr, options, row0, row1, st, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
+                  prov[row0 * w:row1 * w])
+            if progress is not None:
+                progress(row1 / h)
     st.seconds = perf_counter() - start
-    frame = Frame(number, rgb.reshape(h, w), depth.reshape(h, w), prov.reshape(h, w))
-    return frame, st
+    return Frame(number, rgb.reshape(h, w), depth.reshape(h, w), prov.reshape(h, w)), st
 
 
-#: Per-class direction tables are built when classes * pixels stays below this.
-_CLASS_TABLE_LIMIT = 1 << 23
+def set_up(scene: Scene, options: EmuOptions) -> _Frame:
+    """What every band of the frame shares: camera, shape and light tables."""
+    ar = options.arith
+    dtype = np.dtype(ar.dtype)
+    rays = camera_rays(scene, options, ar)
+    cam = np.zeros(native.CAM_COLUMNS, dtype)
+    cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3] = [np.asarray(c, dtype) for c in rays.origin]
+    cam[native.CAM_TMIN], cam[native.CAM_TMAX], cam[native.CAM_Z] = rays.tmin, rays.tmax, rays.z
+    if rays.rotation is not None:  # the kernel turns (x[col], y[row], z) per pixel
+        cam[native.CAM_ROT:native.CAM_ROT + 4] = [np.asarray(c, dtype) for c in rays.rotation]
+    shapes = shapes_from_scene(scene, ar)
+    sf, si = _shape_tables(shapes, dtype)
+    bnd, bounded = bounds.shape_bounds(sf[:, native.SF_LOC:native.SF_LOC + 3], sf[:, native.SF_ROT:native.SF_ROT + 4],
+                                       sf[:, native.SF_INV:native.SF_INV + 3], shapes.kind == SPHERE)
+    lights = lights_from_scene(scene, ar, options.light_model)
+    n = len(sf)
+    view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
+                         native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny)
+    if n:
+        native.kernel("origin_terms", ar.precision, ar.ftz)(byref(view), native.ptr(cam, dtype, (native.CAM_COLUMNS,)))
+    return _Frame(ar, dtype, cam, np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype),
+                  rays.rotation is not None, sf, si, shapes.index.astype(np.int32), bnd, bounded, lights,
+                  _light_rows(lights, dtype), options.jobs or available_cores(), view)
+
+
+def _shape_tables(s: Shapes, dtype: np.dtype) -> tuple[np.ndarray, np.ndarray]:
+    """The kernels' shape tables: floats (SF_COLUMNS, working dtype) and ints (SI_COLUMNS)."""
+    sf = np.zeros((len(s), native.SF_COLUMNS), dtype)
+    for base, values in ((native.SF_LOC, s.loc), (native.SF_ROT, s.rot), (native.SF_INV, s.inv_scale)):
+        for k, v in enumerate(values):
+            sf[:, base + k] = v
+    sf[:, native.SF_ZSIGN], sf[:, native.SF_ONE] = s.zsign, s.one
+    si = np.zeros((len(s), native.SI_COLUMNS), np.int64)
+    r, i, j, k = (sf[:, native.SF_ROT + c] for c in range(4))
+    si[:, native.SI_IDENT] = (r == 1) & (i == 0) & (j == 0) & (k == 0) & ~(np.signbit(i) | np.signbit(j) | np.signbit(k))
+    si[:, native.SI_COLOUR] = s.color
+    return sf, si
 
 
 @dataclass(frozen=True)
-class _DirectionTables:
-    """Normal-space directions (x, y, z) and a2 per (transform class, pixel)."""
+class PixelTrace:
+    """Every intermediate of one pixel (``docs/trace.md``), in working-precision values."""
 
-    first: np.ndarray  # a representative shape of each class
-    cls: np.ndarray  # class of each shape
-    single: bool  # one class: rows are pixels
-    n: int  # pixels
-    columns: list[np.ndarray]
-
-    def read(self, slot: np.ndarray, pix: np.ndarray | slice) -> tuple[Vec, np.ndarray]:
-        if self.single:
-            row = pix
-        else:
-            row = self.cls[slot] * self.n + (np.arange(pix.start, pix.stop) if isinstance(pix, slice) else pix)
-        c = self.columns
-        return (c[0][row], c[1][row], c[2][row]), c[3][row]
+    shapes: np.ndarray  # (shapes, TRACE_SHAPE_VALUES): S, D, a2, b, c2, disc, sqrt, t1, t2, t, hit, sq_dist, point, normal
+    lights: np.ndarray  # (lights, TRACE_LIGHT_VALUES): l, n.l, n_len, l_len, denom, cos, f, fixed, lit, shadow
+    nearest: int  # position of the shape shown in the shape table, -1 none
+    colour: int | None  # RGB565, None: the background
 
 
-def _direction_tables(ar: Arith, shapes: Shapes, rays: Rays) -> _DirectionTables | None:
-    """The direction tables, or None when classes * pixels is too large.
+def trace_pixel(fr: _Frame, options: EmuOptions, x: int, y: int) -> PixelTrace:
+    """Pixel (x, y) computed by the kernels' own functions, keeping every intermediate
+    (shadow rays test every shape)."""
+    n, nl, dtype = len(fr.sf), len(fr.lights), fr.dtype
+    band = native.Band(pointer(fr.shapes), native.ptr(fr.cam, dtype, (native.CAM_COLUMNS,)),
+                       native.ptr(fr.xs, dtype, (options.width,)), native.ptr(fr.ys, dtype, (options.height,)),
+                       int(fr.rotated), int(bool(fr.lights)), options.width, 0)
+    radius = np.full(n, np.inf)
+    lp = native.LightPass(pointer(fr.shapes), pointer(band), None, (0.0, 0.0, 0.0), (0.0,) * 6,
+                          int(options.intensity_fixed), int(n > 1), 0, None, radius.ctypes.data, grids.EMPTY.struct())
+    scales = np.array([[((lt.color >> shift) & top) / top for shift, top in _CHANNELS] for lt in fr.lights]).reshape(-1, 3)
+    shape_out = np.zeros((n, native.TRACE_SHAPE_VALUES))
+    light_out = np.zeros((nl, native.TRACE_LIGHT_VALUES))
+    nearest = np.zeros(1, np.int64)
+    colour = fr.kernel("trace_pixel")(byref(band), byref(lp), fr.light_rows.ctypes.data, scales.ctypes.data,
+                                                nl, x, y, shape_out.ctypes.data, light_out.ctypes.data,
+                                                nearest.ctypes.data)
+    return PixelTrace(shape_out, light_out, int(nearest[0]), None if colour < 0 else int(colour))
 
-    A pair then reads its class's row instead of repeating the rotation: bit-identical,
-    since it is the same sequence of operations on the same values.
-    """
-    first, cls = transform_classes(shapes)
-    n = len(rays.direction[0])
-    if len(first) * n > _CLASS_TABLE_LIMIT:
+
+def _light_rows(lights: list[Light], dtype: np.dtype) -> np.ndarray:
+    rows = np.zeros((len(lights), native.LT_COLUMNS), dtype)
+    for n, light in enumerate(lights):
+        rows[n, native.LT_KIND] = native.LIGHT_POINT if light.kind == POINT else native.LIGHT_DIRECTIONAL
+        rows[n, native.LT_LOC:native.LT_LOC + 3] = [np.asarray(c, dtype) for c in light.location]
+        rows[n, native.LT_DIR:native.LT_DIR + 3] = [np.negative(np.asarray(c, dtype)) for c in light.forward]
+        rows[n, native.LT_INTENSITY] = light.intensity
+    return rows
+
+
+def _chunks(n: int, jobs: int) -> list[tuple[int, int]]:
+    """Pixel ranges for the threads: a few per thread, so that uneven work evens out."""
+    parts = 1 if jobs == 1 else max(1, min(4 * jobs, n // MIN_CHUNK))
+    edges = [n * k // parts for k in range(parts + 1)]
+    return [(a, b) for a, b in zip(edges, edges[1:]) if b > a]
+
+
+def _run(jobs: int, n: int, fn: Callable[..., object], block: object, out: np.ndarray) -> np.ndarray:
+    """``fn(block, p0, p1, out_k)`` over chunks of 0..n on ``jobs`` threads, each chunk with
+    its own copy of ``out``; returns them stacked."""
+    chunks = _chunks(n, jobs)
+    outs = np.stack([out.copy() for _ in chunks])
+    ref = byref(block)
+    if jobs == 1 or len(chunks) == 1:
+        for k, (a, b) in enumerate(chunks):
+            fn(ref, a, b, outs[k].ctypes.data)
+    else:
+        futures = [_pool(jobs).submit(fn, ref, a, b, outs[k].ctypes.data) for k, (a, b) in enumerate(chunks)]
+        for future in futures:
+            future.result()
+    return outs
+
+
+_COUNTERS = np.zeros(3, np.int64)
+
+
+def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, st: FrameStats,
+          rgb: np.ndarray, depth: np.ndarray, prov: np.ndarray) -> None:
+    """Render rows row0..row1 into the band's slices of the frame."""
+    w, n_pix, n, dtype = options.width, (row1 - row0) * options.width, len(fr.sf), fr.dtype
+    lit = bool(fr.lights)
+    a = {  # the band's arrays; the Band block points into them
+        "slot": np.empty(n_pix, np.int32), "sqd": np.empty(n_pix, dtype),
+        "pt": np.empty((n_pix if lit else 0, 3), dtype), "nm": np.empty((n_pix if lit else 0, 3), dtype),
+        "bad": np.zeros(n_pix, np.uint8), "nan_px": np.zeros(n_pix, np.uint8),
+    }
+    band = native.Band(pointer(fr.shapes), native.ptr(fr.cam, dtype, (native.CAM_COLUMNS,)),
+                       native.ptr(fr.xs, dtype, (w,)), native.ptr(fr.ys, dtype, (options.height,)),
+                       int(fr.rotated), int(lit), w, row0)
+    tables = _grid_camera(fr, row0, row1)
+    if tables is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
+        a["dirs"] = np.empty((n_pix, 4), dtype)
+        band.dirs = a["dirs"].ctypes.data
+        boxes = grids.merge_boxes(_run(fr.jobs, n_pix, fr.kernel("directions"), band, grids.EMPTY_BOXES))
+    else:
+        u, v, boxes = tables
+    grid, floor, pc = _primary_grid(fr, boxes)
+    if tables is not None:
+        a["col_cell"], a["row_cell"] = _cells(grid, u, 2), _cells(grid, v, 2, rows=True)
+        band.col_cell, band.row_cell = a["col_cell"].ctypes.data, a["row_cell"].ctypes.data
+    band.pc, band.floor, band.grid = pc.ctypes.data, floor.ctypes.data, grid.struct()
+    for name in ("slot", "sqd", "pt", "nm", "bad", "nan_px"):
+        setattr(band, name, a[name].ctypes.data)
+    c = _run(fr.jobs, n_pix, fr.kernel("nearest"), band, _COUNTERS).sum(axis=0)
+    st.tests += int(c[native.C_TESTS])
+    st.nan_tests += int(c[native.C_NAN_TESTS])
+    st.skipped += n_pix * n - int(c[native.C_TESTS])
+    acc = np.zeros((n_pix if lit else 0, 3))
+    for k in range(len(fr.lights)):
+        _light(fr, options, k, band, a, acc, st)
+    st.hits += fr.kernel("finish")(byref(band), acc.ctypes.data, fr.index.ctypes.data, options.background, 0, n_pix,
+                                   native.ptr(rgb, np.uint16, (n_pix,)), native.ptr(depth, np.float32, (n_pix,)),
+                                   native.ptr(prov, np.int32, (n_pix,)))
+    st.nan_rays += int(a["nan_px"].sum())
+
+
+def _grid_camera(fr: _Frame, row0: int, row1: int) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """For a camera whose directions are (x[col], y[row], z), z finite and not zero: each
+    column's u = x/z and each row's v = y/z (their lines' coordinates on face 2, shared
+    by the grid and the lookups) and the face boxes; else None."""
+    z = float(fr.cam[native.CAM_Z])
+    if fr.rotated or not (z != 0 and np.isfinite(z)):
         return None
-    columns = [np.empty(len(first) * n, ar.dtype) for _ in range(4)]
-    for k, rep in enumerate(first):
-        s = shapes.take(int(rep))  # scalars: they broadcast cheaper than one-element arrays
-        for lo, hi, shape, d in _direction_chunks(rays):
-            _, Dh = to_object(ar, s, None, d)
-            for column, value in zip(columns, (*Dh, direction_term(ar, s, Dh))):
-                column[k * n + lo:k * n + hi].reshape(shape)[...] = value
-    return _DirectionTables(first, cls, len(first) == 1, n, columns)
+    xs, ys = fr.xs.astype(np.float64), fr.ys[row0:row1].astype(np.float64)
+    u, v = xs / z, ys / z
+    boxes = grids.EMPTY_BOXES.copy()
+    fu, fv = u[np.isfinite(u)], v[np.isfinite(v)]
+    if len(fu) and len(fv):
+        shortest = np.sqrt(np.min(xs[np.isfinite(u)] ** 2) + np.min(ys[np.isfinite(v)] ** 2) + z * z)
+        longest = np.sqrt(np.max(xs[np.isfinite(u)] ** 2) + np.max(ys[np.isfinite(v)] ** 2) + z * z)
+        boxes[2] = (fu.min(), fu.max(), fv.min(), fv.max(), len(fu) * len(fv), shortest, longest)
+    return u, v, boxes
 
 
-def _longest(rays: Rays) -> float:
-    """An upper bound of the primary directions' lengths."""
-    if rays.grid is not None:
-        x, y, z = (np.abs(np.asarray(c, np.float64)).max(initial=0.0) for c in rays.grid)
-        return float(np.sqrt(x * x + y * y + z * z)) * (1 + 1e-9)
-    d = _f64(rays.direction)
-    return float(np.sqrt(np.einsum("ij,ij->i", d, d).max(initial=0.0))) * (1 + 1e-9)
+def _cells(grid: grids.Grid, coords: np.ndarray, face: int, rows: bool = False) -> np.ndarray:
+    """Per column (u) or row (v) of a grid camera, its part of the cell index on ``face``,
+    as the kernels' cell_of computes it; -1 outside the grid."""
+    nu, nv, first = (int(c) for c in grid.shape[face])
+    lo, hi, scale = (grid.faces[face, k] for k in ((2, 3, 5) if rows else (0, 1, 4)))
+    count = nv if rows else nu
+    inside = (lo <= coords) & (coords <= hi) & (count > 0)
+    index = np.minimum(((np.where(inside, coords, lo) - lo) * scale).astype(np.int64), count - 1)
+    return np.where(inside, first + index * nu if rows else index, -1).astype(np.int64)
 
 
-def _squared_lengths(ar: Arith, rays: Rays) -> np.ndarray:
-    """|d|^2 of every primary ray (from a grid camera, products once per column and row)."""
-    if rays.grid is None:
-        return dot(ar, rays.direction, rays.direction)
-    x, y, z = rays.grid
-    d = (x[None, :], y[:, None], z)
-    return np.broadcast_to(dot(ar, d, d), (len(y), len(x))).ravel()
+def _primary_grid(fr: _Frame, boxes: np.ndarray) -> tuple[grids.Grid, np.ndarray, np.ndarray]:
+    """The primary rays' grid, and per shape its depth floor and cull data."""
+    used = boxes[:, 4] > 0
+    dmin = float(boxes[used, 5].min()) if used.any() else 0.0
+    dmax = float(boxes[used, 6].max()) if used.any() else 0.0
+    apex = fr.cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)
+    bounded = fr.bounded & bool(np.isfinite(apex).all())
+    with np.errstate(all="ignore"):  # a camera at infinity: nothing is bounded
+        centers = fr.bnd[:, :3] - apex
+        dist = np.linalg.norm(centers, axis=1)
+    u, tiny = fr.ar.unit_roundoff, fr.ar.tiny
+    radius = bounds.cull_radii(fr.bnd, bounded, dist, dmin, u, tiny, fr.fp16)
+    floor = bounds.depth_floors(fr.bnd, bounded, dist, dmin, dmax, u, tiny)
+    pc = np.empty((len(radius), native.PC_COLUMNS))
+    native.library().bound_primary(fr.bnd.ctypes.data, radius.ctypes.data, len(radius), apex.ctypes.data, dmin, u,
+                                   tiny, pc.ctypes.data)
+    order = np.argsort(floor, kind="stable").astype(np.int32)
+    return grids.build(boxes, False, centers, radius, order), floor, pc
 
 
-def _direction_chunks(rays: Rays) -> Iterator[tuple[int, int, tuple[int, ...], Vec]]:
-    """The primary directions in cache-sized pieces: (first pixel, end, shape, directions).
-
-    From a grid camera the pieces are rows, with directions as (1, w), (rows, 1) and 0-d
-    arrays: products of one coordinate are then computed once per column or row, and only
-    the sums that mix them per pixel (the same operations on the same values).
-    """
-    n = len(rays.direction[0])
-    if rays.grid is None:
-        for lo in range(0, n, PAIR_CHUNK):
-            hi = min(n, lo + PAIR_CHUNK)
-            yield lo, hi, (hi - lo,), tuple(c[lo:hi] for c in rays.direction)
-        return
-    x, y, z = rays.grid
-    w = len(x)
-    step = max(1, PAIR_CHUNK // w)
-    for r in range(0, len(y), step):
-        rows = y[r:r + step]
-        yield r * w, (r + len(rows)) * w, (len(rows), w), (x[None, :], rows[:, None], z)
+#: shadow_origins' output: bounding box of the points, largest magnitude, largest chord,
+#: then the face boxes.
+_ORIGINS = np.concatenate([[np.inf] * 3 + [-np.inf] * 3 + [0.0, 0.0], grids.EMPTY_BOXES.ravel()])
 
 
-def _primary(ar: Arith, options: EmuOptions, rays, dd, shapes: Shapes, bounds: Bounds,
-             st: FrameStats, nan_pixel: np.ndarray, progress: Progress | None):
-    """Nearest hit of every primary ray; origin terms are per shape, direction terms per
-    transform class and pixel. Returns the nearest hits, the direction tables (or None)
-    and the per-shape normal-space origins."""
-    n_pix = options.pixels
-    near = _Nearest(n_pix, ar.dtype)
-    S_shape, _ = to_object(ar, shapes, rays.origin, None)
-    c2_shape = origin_term(ar, shapes, S_shape)
-    tables = _direction_tables(ar, shapes, rays)
-    form = uniform_form(shapes)
-    coarse, tiles = screen_tiles(n_pix, options.width), screen_tiles(n_pix, options.width, FINE)
-    rnd = Rounding.of(ar)
-    apex = _f64(rays.origin)[0]
-    floor = order = None
-    if options.cull:  # cones of the coarse tiles, then of the fine tiles inside the kept ones
-        children = screen_children(n_pix, options.width)
-        if rays.grid is not None:
-            cones, fine_cones = (grid_cones(*rays.grid, t, options.width) for t in (coarse, tiles))
-        else:
-            cones, fine_cones = (tile_cones(t, _f64_rows(rays.direction, t.order)) for t in (coarse, tiles))
-        floor = depth_floor(bounds, apex, float(cones.dmin.min()), _longest(rays), rnd)
-        order = np.argsort(floor, kind="stable")  # front to back: near hits then skip far shapes
-    blocks = list(shape_blocks(len(shapes), len(coarse), order))
-    def test(batch, reached):
-        pix, slot = batch
-        if reached is not None:
-            pix, slot = _pick(np.take(floor, slot) <= np.take(reached, pix), pix, slot)
-        if tables is None:
-            s = shapes.take(slot)
-            _, Dh = to_object(ar, s, None, _take(rays.direction, pix))
-            a2 = None
-        else:
-            s = form or Form(shapes.zsign[slot])
-            Dh, a2 = tables.read(slot, pix)
-        one = _one(slot)  # a batch on one shape: its values broadcast
-        sol = solve(ar, s, _take(S_shape, one), Dh, c2_shape[one], rays.tmin, rays.tmax, a2)
-        sqd = squared_distance(ar, dd[pix], sol.t)
-        bad = sol.bad | (sol.hit & ~np.isfinite(sqd))
-        return pix, slot, sqd, sol.t, sol.hit & ~bad, bad
-
-    for done, sel in enumerate(blocks):
-        if options.cull:
-            ci, si = np.nonzero(cone_keep(cones, apex, None, bounds, sel, rnd))
-            fi, si = children[ci].ravel(), np.repeat(si, children.shape[1])
-            fi, si = _pick(fi >= 0, fi, si)
-            fi, si = _pick(cone_keep_cells(fine_cones, fi, apex, bounds, sel[si], rnd), fi, si)
-            passes = _depth_passes(tiles, len(sel), fi, si, floor[sel[si]], near)
-        else:
-            passes = [(np.ones((len(tiles), len(sel)), bool), None)]
-        for keep, reached in passes:
-            for batch in pairs(tiles, keep, sel, distinct=True):
-                pix, slot, sqd, t, hit, bad = test(batch, reached)
-                st.tests += len(pix)
-                st.nan_tests += int(bad.sum())
-                nan_pixel[_pick(bad, pix)[0]] = True
-                near.update(pix, slot, sqd, t, distinct=True, hit=hit)
-        if progress is not None:
-            progress((done + 1) / len(blocks))
-    st.skipped += n_pix * len(shapes) - st.tests
-    return near, tables, S_shape
+def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, a: dict[str, np.ndarray], acc: np.ndarray,
+           st: FrameStats) -> None:
+    """Add light ``k`` to the band's colour sums, with its shadow rays."""
+    light = fr.light_rows[k]
+    colour = fr.lights[k].color
+    n_pix, n = len(a["slot"]), len(fr.sf)
+    shadows = n > 1
+    point = light[native.LT_KIND] == native.LIGHT_POINT
+    lp = native.LightPass(pointer(fr.shapes), pointer(band), native.ptr(light, fr.dtype, (native.LT_COLUMNS,)),
+                          (*[((colour >> shift) & top) / top for shift, top in _CHANNELS],))
+    lp.fixed, lp.shadows, lp.parallel, lp.acc = int(options.intensity_fixed), int(shadows), int(not point), acc.ctypes.data
+    if shadows:  # the block points into grid, radius and along: they live until the pass is done
+        grid, radius, along = _shadow_grid(fr, lp, light, n_pix)
+        lp.grid, lp.radius, lp.along = grid.struct(), radius.ctypes.data, along.ctypes.data
+    c = _run(fr.jobs, n_pix, fr.kernel("light_pass"), lp, _COUNTERS).sum(axis=0)
+    st.shadow_rays += int(c[native.C_SHADOW_RAYS])
+    st.tests += int(c[native.C_TESTS])
+    st.nan_tests += int(c[native.C_NAN_TESTS])
+    if shadows:
+        st.skipped += int(c[native.C_SHADOW_RAYS]) * (n - 1) - int(c[native.C_TESTS])
 
 
-def _depth_passes(tiles: Tiles, n_sel: int, fi: np.ndarray, si: np.ndarray, low: np.ndarray,
-                  near: _Nearest) -> list[tuple[np.ndarray, np.ndarray | None]]:
-    """The kept cells (fine tile ``fi``, shape ``si`` of the block, depth floor ``low``) as
-    passes of (keep matrix, nearest hits to check pairs against, or None).
+def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray,
+                 n_pix: int) -> tuple[grids.Grid, np.ndarray, np.ndarray]:
+    """The grid of a light's shadow rays from the band's hit points (``lp`` gets its
+    frame): (grid, cull radii, per-shape terms along a directional light's l)."""
+    n = len(fr.sf)
+    centers = fr.bnd[:, :3]
+    along = np.zeros((0, 4), fr.dtype)
+    point = not lp.parallel
+    if point:
+        apex = light[native.LT_LOC:native.LT_LOC + 3].astype(np.float64)
+        lp.frame[:3] = apex
+    else:
+        l = light[native.LT_DIR:native.LT_DIR + 3].astype(np.float64)
+        length = float(np.sqrt(l @ l)) if np.isfinite(l).all() else 0.0
+        if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
+            return grids.EMPTY, np.full(n, np.inf), along
+        axes = _normal_plane(l / length)
+        lp.frame[:] = axes.ravel()
+    out = _run(fr.jobs, n_pix, fr.kernel("shadow_origins"), lp, _ORIGINS)
+    lo, hi = out[:, :3].min(axis=0), out[:, 3:6].max(axis=0)
+    magnitude, chord = out[:, 6].max(), out[:, 7].max()
+    boxes = grids.merge_boxes(out[:, 8:].reshape(len(out), 3, native.BOX_COLUMNS))
+    if not boxes[:, 4].any():  # no hit point: no shadow ray
+        return grids.EMPTY, np.full(n, np.inf), along
+    with np.errstate(all="ignore"):
+        mid, half = (lo + hi) / 2, np.sqrt(((hi - lo) ** 2).sum()) / 2
+        far = np.sqrt(((centers - mid) ** 2).sum(axis=1)) * (1 + bounds.SLACK) + half  # to any origin, at most
+        slack = 1e-12 * (np.sqrt((centers ** 2).sum(axis=1)) + magnitude)
+    u, tiny = fr.ar.unit_roundoff, fr.ar.tiny
+    if point:
+        bounded = fr.bounded & bool(np.isfinite(apex).all())
+        radius = bounds.cull_radii(fr.bnd, bounded, far, float(boxes[:, 5].min()), u, tiny, fr.fp16)
+        radius += far * (chord * (1 + bounds.SLACK) + 1e-15) + slack
+        return grids.build(boxes, False, centers - apex, radius, np.arange(n, dtype=np.int32)), radius, along
+    radius = bounds.cull_radii(fr.bnd, fr.bounded, far, length, u, tiny, fr.fp16) + slack
+    flat = np.zeros((n, 3))
+    with np.errstate(all="ignore"):  # unbounded shapes (infinite centres) have an infinite radius
+        flat[:, :2] = _project(centers, axes)
+    along = np.empty((n, 4), fr.dtype)
+    fr.kernel("shadow_directions")(byref(fr.shapes), light.ctypes.data, along.ctypes.data)
+    return grids.build(boxes, True, flat, radius, np.arange(n, dtype=np.int32)), radius, along
 
-    A shape whose every hit is farther than a pixel's nearest hit so far cannot win it:
-    cells whose floor is at most every nearest hit in their tile are tested unchecked,
-    cells whose floor exceeds some of them pair by pair, cells whose floor exceeds all of
-    them not at all.
-    """
-    def matrix(cells: np.ndarray) -> np.ndarray:
-        keep = np.zeros((len(tiles), n_sel), bool)
-        keep[_pick(cells, fi, si)] = True
-        return keep
 
-    if not near.any:
-        return [(matrix(np.ones(len(fi), bool)), None)]
-    reached = near.sqd.copy()
-    in_tiles = reached[tiles.order]
-    sure = low <= tile_reduce(tiles, in_tiles, np.minimum)[fi]
-    check = ~sure & (low <= tile_reduce(tiles, in_tiles, np.maximum)[fi])
-    return [(matrix(sure), None), (matrix(check), reached)]
+def _project(points: np.ndarray, axes: np.ndarray) -> np.ndarray:
+    """Points (n, 3) projected on axes (k, 3): (n, k), element-wise (BLAS would start
+    its own spinning threads for a product this small)."""
+    return np.stack([points[:, 0] * a[0] + points[:, 1] * a[1] + points[:, 2] * a[2] for a in axes], axis=1)
 
 
-def shade_hits(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, lights: list[Light], hp: np.ndarray,
-               slot: np.ndarray, point: Vec, normal: Vec, st: FrameStats, nan_pixel: np.ndarray,
-               record: Recorder | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """RGB565 per hit pixel and a mask of pixels whose shading met NaN or infinity.
-
-    ``hp`` are the pixels, ``slot`` their shapes' positions, ``point``/``normal`` the world
-    hit points and normals. Lighting is :func:`.lighting.diffuse` (shared with the
-    rasterizer) with shadow rays as its occlusion test; ``record`` sees every stage.
-    """
-    def occluded(light: Light, lit: np.ndarray, l_lit: Vec) -> np.ndarray:
-        if len(shapes) < 2:  # nothing else to cast a shadow
-            st.shadow_rays += len(lit)
-            return np.zeros(len(lit), dtype=bool)
-        return _shadowed(ar, options, shapes, bounds, light, _take(point, lit), l_lit, hp[lit], slot[lit], st, nan_pixel)
-
-    return diffuse(ar, shapes.color[slot], normal, point, lights, occluded, options.intensity_fixed, record)
-
-
-def _shadowed(ar: Arith, options: EmuOptions, shapes: Shapes, bounds: Bounds, light: Light, origin: Vec,
-              direction: Vec, pix: np.ndarray, own: np.ndarray, st: FrameStats, nan_pixel: np.ndarray) -> np.ndarray:
-    """Whether another shape lies on each shadow ray (t > 0; before the light if a point)."""
-    n = len(pix)
-    blocked = np.zeros(n, dtype=bool)
-    st.shadow_rays += n
-    if n == 0:
-        return blocked
-    tmax = ar.const(1.0 if light.kind == POINT else np.inf)
-    tmin = ar.const(0.0)
-    tiles = subset_tiles(screen_tiles(options.pixels, options.width), pix)  # pix: sorted hit pixels
-    rnd = Rounding.of(ar)
-    before = st.tests
-    if options.cull:
-        org = _f64_rows(origin, tiles.order)
-        if light.kind == POINT:
-            apex = _f64(light.location)[0]
-            cones = tile_cones(tiles, _f64_rows(direction, tiles.order))
-            boxes = tile_boxes(tiles, org)
-        else:
-            bundle = parallel_rays(tiles, _f64(direction)[0], org)
-    per_shape = None
-    if light.kind != POINT:  # one direction for every shadow ray: its normal-space terms per shape
-        _, D_shape = to_object(ar, shapes, None, direction)
-        per_shape = D_shape, direction_term(ar, shapes, D_shape)
-    for sel in shape_blocks(len(shapes), len(tiles)):
-        open_ = None
-        if not options.cull:
-            keep = np.ones((len(tiles), len(sel)), bool)
-        else:
-            keep = (cone_keep(cones, apex, boxes, bounds, sel, rnd) if light.kind == POINT
-                    else parallel_keep(bundle, bounds, sel, rnd))
-            if blocked.any():  # a ray already blocked needs no more tests
-                open_ = ~blocked
-                keep &= tile_reduce(tiles, open_[tiles.order], np.logical_or)[:, None]
-
-        def test(batch):
-            pos, slot = batch
-            other = slot != own[pos] if open_ is None else (slot != own[pos]) & open_[pos]
-            pos, slot = _pick(other, pos, slot)
-            s = shapes.take(slot)
-            if per_shape is None:
-                S, D = to_object(ar, s, _take(origin, pos), _take(direction, pos))
-                a2 = None
-            else:
-                S, _ = to_object(ar, s, _take(origin, pos), None)
-                D, a2 = _take(per_shape[0], slot), per_shape[1][slot]
-            sol = solve(ar, s, S, D, origin_term(ar, s, S), tmin, tmax, a2)
-            return pos, sol.hit, sol.bad
-
-        for pos, hit, bad in map(test, pairs(tiles, keep, sel)):
-            st.tests += len(pos)
-            st.nan_tests += int(bad.sum())
-            nan_pixel[pix[_pick(bad, pos)[0]]] = True
-            blocked[_pick(hit, pos)[0]] = True
-    st.skipped += n * (len(shapes) - 1) - (st.tests - before)
-    return blocked
+def _normal_plane(d: np.ndarray) -> np.ndarray:
+    """Two orthonormal vectors (2, 3) normal to the unit vector d."""
+    e1 = np.cross(d, [1.0, 0.0, 0.0] if abs(d[0]) < 0.9 else [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    return np.stack([e1, np.cross(d, e1)])

@@ -1,9 +1,10 @@
 """Pixel traces: every working-precision intermediate of chosen pixels (``docs/trace.md``).
 
-The traced pixel is run through the renderer's own functions on a batch that holds it
-once per shape (the raycaster's ``to_object``, ``origin_term``, ``solve``,
-``squared_distance``, ``surface``; the raytracer's nearest-hit rule and shading with a
-recording hook), so the trace shows what the frame computed, not a re-derivation.
+A raytraced pixel is computed by the compiled kernels' own functions (``trace_pixel`` in
+``csrc/datapath.inc``: the same transform, solve, nearest-hit rule, lighting and shadow
+test the frame uses, keeping every intermediate); a rasterized pixel by the
+rasterizer's own functions with a recording hook. The trace shows what the frame
+computed, not a re-derivation.
 """
 
 from __future__ import annotations
@@ -15,11 +16,8 @@ from typing import Callable, Iterable
 import numpy as np
 
 from .arith import Arith
-from .camera import camera_rays
 from .options import EmuOptions
 from .scene import Scene
-from .shapes import origin_term, shapes_from_scene, solve, squared_distance, surface, to_object
-from .vec import dot
 
 Emit = Callable[[dict], None]
 _BITS = {"fp16": (np.float16, np.uint16, 4), "fp32": (np.float32, np.uint32, 8), "fp64": (np.float64, np.uint64, 16)}
@@ -58,63 +56,37 @@ def parse_pixel(text: str) -> tuple[int, int]:
     return x, y
 
 
+_SHAPE_STAGES = ("origin.x", "origin.y", "origin.z", "dir.x", "dir.y", "dir.z", "a2", "b", "c2", "disc", "sqrt",
+                 "t1", "t2", "t", "hit", "sq_dist", "point.x", "point.y", "point.z", "normal.x", "normal.y", "normal.z")
+_LIGHT_STAGES = ("l.x", "l.y", "l.z", "n_dot_l", "n_len", "l_len", "denom", "cos", "f")
+_FIXED, _LIT, _SHADOW = 9, 10, 11
+
+
 def trace_raytrace(scene: Scene, options: EmuOptions, frame: int, pixels: Iterable[tuple[int, int]], emit: Emit) -> None:
     """Emit the records of each pixel of one raytraced frame (``docs/trace.md`` order)."""
-    from .raytracer import _Nearest, shade_hits
-    from .cull import shape_bounds
-    from .lights import lights_from_scene
-    from .stats import FrameStats
+    from .raytracer import set_up, trace_pixel
 
     ar = options.arith
-    rays = camera_rays(scene, options, ar)
-    shapes = shapes_from_scene(scene, ar)
-    lights = lights_from_scene(scene, ar, options.light_model)
-    n = len(shapes)
-    slots = np.arange(n)
+    fr = set_up(scene, options)
     for x, y in pixels:
         w = _Writer(ar, emit, frame, (x, y))
-        p = y * options.width + x
-        D1 = tuple(np.broadcast_to(d, (options.pixels,))[p : p + 1] for d in rays.direction)
-        D = tuple(np.repeat(c, n) for c in D1)
-        S, Dh = to_object(ar, shapes, rays.origin, D)
-        c2 = origin_term(ar, shapes, S)
-        sol = solve(ar, shapes, S, Dh, c2, rays.tmin, rays.tmax)
-        sqd = squared_distance(ar, dot(ar, D1, D1), sol.t)
-        point, normal = surface(ar, shapes, S, Dh, sol.t, rays.origin, D)
-        hit = sol.hit & np.isfinite(sqd)
-        for k in range(n):
-            idx = int(shapes.index[k])
-            for axis in range(3):
-                w.put(f"origin.{'xyz'[axis]}", S[axis][k], idx)
-            for axis in range(3):
-                w.put(f"dir.{'xyz'[axis]}", Dh[axis][k], idx)
-            for stage, arr in (("a2", sol.a2), ("b", sol.b), ("c2", c2), ("disc", sol.disc), ("sqrt", sol.root),
-                               ("t1", sol.t1), ("t2", sol.t2), ("t", sol.t)):
-                w.put(stage, arr[k], idx)
-            w.put("hit", int(hit[k]), idx, integer=True)
-            w.put("sq_dist", sqd[k], idx)
-            for axis in range(3):
-                w.put(f"point.{'xyz'[axis]}", np.broadcast_to(point[axis], (n,))[k], idx)
-            for axis in range(3):
-                w.put(f"normal.{'xyz'[axis]}", normal[axis][k], idx)
-        near = _Nearest(1, ar.dtype)
-        near.update(np.zeros(int(hit.sum()), dtype=np.int64), slots[hit], sqd[hit])
-        best = int(near.slot[0]) if near.slot[0] != np.iinfo(np.int64).max else -1
-        shown = int(shapes.index[best]) if best >= 0 else None
+        t = trace_pixel(fr, options, x, y)
+        for slot, values in enumerate(t.shapes):
+            idx = int(fr.index[slot])
+            for stage, value in zip(_SHAPE_STAGES, values):
+                w.put(stage, int(value) if stage == "hit" else value, idx, integer=stage == "hit")
+        shown = int(fr.index[t.nearest]) if t.nearest >= 0 else None
         w.put("nearest", -1 if shown is None else shown, shown, integer=True)
-        colour = options.background
-        if best >= 0:
-            one = np.array([best])
-            pt = tuple(np.broadcast_to(c, (n,))[one] for c in point)
-            nm = tuple(c[one] for c in normal)
-            rgb, bad = shade_hits(
-                ar, options, shapes, shape_bounds(shapes), lights, np.array([p]), one, pt, nm,
-                FrameStats(), np.zeros(options.pixels, dtype=bool),
-                record=lambda stage, v: _put_all(w, stage, v, shown),
-            )
-            if not bad[0]:
-                colour = int(rgb[0])
-        w.put("colour", colour, shown, integer=True)
+        if shown is not None:
+            for light, values in zip(fr.lights, t.lights):
+                tag = f"L{light.index}."
+                for stage, value in zip(_LIGHT_STAGES, values):
+                    w.put(tag + stage, value, shown)
+                if options.intensity_fixed:
+                    w.put(tag + "fixed", int(values[_FIXED]), shown, integer=True)
+                if values[_LIT]:
+                    w.put(tag + "shadow", int(values[_SHADOW]), shown, integer=True)
+        w.put("colour", options.background if t.colour is None else t.colour, shown, integer=True)
 
 
 def trace_raster(scene: Scene, options: EmuOptions, frame: int, pixels: Iterable[tuple[int, int]], emit: Emit) -> None:

@@ -1,4 +1,5 @@
-"""The worked float16 vectors of original-device.md, bit for bit (fp16, flush to zero)."""
+"""The worked float16 vectors of the original device's documentation, bit for bit (fp16,
+flush to zero), from the reference raycaster and from the compiled kernels alike."""
 
 import numpy as np
 import pytest
@@ -7,7 +8,7 @@ from rend3r.emu.arith import make_arith
 from rend3r.emu.camera import camera_rays
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.processor import execute
-from rend3r.emu.raytracer import render_frame
+from rend3r.emu.raytracer import render_frame, set_up, trace_pixel
 from rend3r.emu.scene import Scene
 from rend3r.emu.shapes import origin_term, shapes_from_scene, solve, squared_distance, surface, to_object
 from rend3r.emu.vec import dot
@@ -27,6 +28,17 @@ def _scene() -> Scene:
     scene = Scene()
     execute(PROGRAM.words, DEVICE, scene=scene)
     return scene
+
+
+_KERNEL_STAGES = dict(a2=6, b=7, c2=8, disc=9, sqrt=10, t1=11, t2=12, t=13, sq_dist=15)
+
+
+def _kernel_trace(x: int, y: int) -> dict[str, int]:
+    """The same values from the compiled kernels' own trace of the pixel."""
+    t = trace_pixel(set_up(_scene(), DEVICE), DEVICE, x, y)
+    values = {k: t.shapes[0, i] for k, i in _KERNEL_STAGES.items()}
+    values["I"] = t.lights[0, 7]
+    return {k: _bits(v) for k, v in values.items()}
 
 
 def _trace(x: int, y: int) -> dict[str, int]:
@@ -57,22 +69,23 @@ def test_device_ray_directions_are_float16_accumulations():
     assert (np.diff(dx[0]) > 0).all() and (np.diff(dy[:, 0]) > 0).all()  # row 0 is world y = -3.74
 
 
-def test_worked_vector_pixel_256_192():
-    got = _trace(256, 192)
+@pytest.mark.parametrize("trace", [_trace, _kernel_trace], ids=["reference", "kernels"])
+def test_worked_vector_pixel_256_192(trace):
+    got = trace(256, 192)
     want = dict(a2=0x4000, b=0xC400, c2=0x4600, disc=0x4400, sqrt=0x4000, t1=0x3C00, t2=0x4200, t=0x3C00, sq_dist=0x3C00)
     assert {k: got[k] for k in want} == want
     assert got["I"] & 0x8000  # negative: the pixel is black
 
 
-def test_worked_vector_pixel_252_188():
-    got = _trace(252, 188)
+@pytest.mark.parametrize("trace", [_trace, _kernel_trace], ids=["reference", "kernels"])
+def test_worked_vector_pixel_252_188(trace):
+    got = trace(252, 188)
     assert {k: got[k] for k in ("a2", "b", "c2", "t", "sq_dist", "I")} == dict(
         a2=0x4009, b=0xC400, c2=0x4600, t=0x3C05, sq_dist=0x3C13, I=0x2E22)
 
 
-@pytest.mark.parametrize("cull", [True, False])
-def test_rendered_pixels_of_the_worked_scene(cull):
-    frame, stats = render_frame(_scene(), EmuOptions(camera="device", cull=cull))
+def test_rendered_pixels_of_the_worked_scene():
+    frame, stats = render_frame(_scene(), DEVICE)
     assert frame.rgb565[192, 256] == 0  # I negative
     # white shape, white light of intensity 1: channel * I, rounded: 31*0.0958 -> 3, 63*0.0958 -> 6
     assert frame.rgb565[188, 252] == (3 << 11) | (6 << 5) | 3
@@ -81,26 +94,9 @@ def test_rendered_pixels_of_the_worked_scene(cull):
     assert stats.nan_rays == 0
 
 
-def test_shading_stages_are_recorded_with_the_device_intensity():
-    from rend3r.emu.cull import shape_bounds
-    from rend3r.emu.lights import lights_from_scene
-    from rend3r.emu.raytracer import shade_hits
-    from rend3r.emu.stats import FrameStats
-
-    ar = make_arith("fp16", "ftz")
-    scene = _scene()
-    rays = camera_rays(scene, DEVICE, ar)
-    shapes = shapes_from_scene(scene, ar)
-    p = 188 * DEVICE.width + 252
-    D = tuple(d[p : p + 1] for d in rays.direction)
-    S, Dh = to_object(ar, shapes, rays.origin, D)
-    sol = solve(ar, shapes, S, Dh, origin_term(ar, shapes, S), rays.tmin, rays.tmax)
-    point, normal = surface(ar, shapes, S, Dh, sol.t, rays.origin, D)
-    seen = {}
-    rgb, bad = shade_hits(ar, DEVICE, shapes, shape_bounds(shapes), lights_from_scene(scene, ar), np.array([p]),
-                          np.array([0]), point, normal, FrameStats(), np.zeros(DEVICE.pixels, bool),
-                          record=lambda stage, v: seen.setdefault(stage, np.asarray(v).copy()))
-    assert list(seen) == [f"L0.{s}" for s in ("l.x", "l.y", "l.z", "n_dot_l", "n_len", "l_len", "denom", "cos", "f",
-                                              "shadow")]
-    assert _bits(seen["L0.cos"]) == 0x2E22 and seen["L0.shadow"].tolist() == [0]
-    assert not bad[0] and rgb[0] == (3 << 11) | (6 << 5) | 3
+def test_shading_stages_of_the_worked_pixel():
+    """The kernels' light stages at (252, 188): l = -forward, I, no shadow (one shape)."""
+    t = trace_pixel(set_up(_scene(), DEVICE), DEVICE, 252, 188)
+    l_x, l_y, l_z, *_, cos, f, fixed, lit, shadow = t.lights[0]
+    assert (l_x, l_y, l_z) == (-1.0, -1.0, 0.0) and _bits(cos) == 0x2E22 and (lit, shadow) == (1, 0)
+    assert t.colour == (3 << 11) | (6 << 5) | 3

@@ -1,0 +1,119 @@
+/* Conservative bounds, in double: when a ray provably cannot hit a shape, or cannot hit it
+ * nearer than some distance, *as the working-precision raycaster computes it*
+ * (docs/emulator.md section 7 derives each).
+ *
+ * cull_radius: a world radius around the centre; a ray whose line stays farther gets a
+ *   negative computed discriminant.
+ * misses: the line is farther than that, or the shape lies behind the ray's origin (then
+ *   the computed b = 2 D.S and c2 are positive, sqrt(fl(b*b - a2*c2)) <= b and neither
+ *   root is positive).
+ * depth_floor: a lower bound of any computed sq_dist of a ray from one apex.
+ */
+#ifndef REND3R_BOUNDS_H
+#define REND3R_BOUNDS_H
+
+#include <math.h>
+
+#include "kernels.h"
+
+#define BOUND_SLACK 1e-9
+/* A finite float16 a2*c2 is below 65520; with the coefficients' rounding error allowed
+ * for, |D|^2 (|S|^2 - 1) stays below 16380 * 1.02 / (1 - 2**-6)**2. */
+#define F16_PRODUCT_LIMIT (16380.0 * 1.02 / ((1.0 - 0.015625) * (1.0 - 0.015625)))
+
+/* dist bounds the distance from the rays' origins to the centre, dmin the rays' direction
+ * lengths from below; INFINITY: no bound. */
+static inline double cull_radius(double smin, double smax, double dist, double dmin, double u, double tiny,
+                                 int fp16)
+{
+    double dhat = smin * dmin;  /* |D| in normal space, at least */
+    if (!(dhat >= 0.0625))
+        return INFINITY;
+    double uu = u + tiny / fmin(1.0, dhat * dhat);
+    double mm = smax * dist;
+    if (fp16) {
+        double cap = sqrt(1.0 + F16_PRODUCT_LIMIT / (dhat * dhat));
+        mm = mm < cap ? mm : cap;
+    }
+    double h = sqrt(1.0 + 24.0 * uu * (1.0 + mm * mm)) + 16.0 * uu * mm * (1.0 + smax / smin);
+    double r = h / smin * (1.0 + BOUND_SLACK) + BOUND_SLACK;
+    return isfinite(r) ? r : INFINITY;
+}
+
+static inline int misses(const double *b, double r, double o0, double o1, double o2, double d0, double d1,
+                         double d2, double u, double tiny)
+{
+    if (!(r < INFINITY))
+        return 0;
+    double v0 = b[B_CENTER] - o0, v1 = b[B_CENTER + 1] - o1, v2 = b[B_CENTER + 2] - o2;
+    double vv = v0 * v0 + v1 * v1 + v2 * v2, vd = v0 * d0 + v1 * d1 + v2 * d2, dd = d0 * d0 + d1 * d1 + d2 * d2;
+    if (vv - vd * vd / dd > r * r * (1.0 + BOUND_SLACK) + 1e-12 * vv)
+        return 1;  /* off the line */
+    double dist = sqrt(vv);
+    if (!(dist > r))
+        return 0;
+    double smin = b[B_SMIN], smax = b[B_SMAX], dlen = sqrt(dd);
+    double uu = u + tiny / fmin(1.0, (smin * dlen) * (smin * dlen));
+    double mean2 = (smax * smax + smin * smin) / 2.0, spread2 = (smax * smax - smin * smin) / 2.0;
+    double ahead = -vd / dlen;  /* (origin - centre) . d / |d| */
+    return dlen * (mean2 * ahead - (spread2 + 64.0 * uu * smax * smax) * dist) > 0.015625;  /* behind */
+}
+
+/* A primary ray in double, with what the cull tests need of it (len: sqrt(dd) once the
+ * behind test needs it, else -1). */
+typedef struct { double d0, d1, d2, dd, len; } Ray;
+
+static inline Ray ray_of(double d0, double d1, double d2)
+{
+    Ray r = {d0, d1, d2, d0 * d0 + d1 * d1 + d2 * d2, -1.0};
+    return r;
+}
+
+/* misses() for rays from the camera, with the per-shape parts computed once per band
+ * (rend3r/emu/raytracer.py primary_cull_table): pc holds v = centre - camera, |v|^2,
+ * r^2 (1 + slack) + 1e-12 |v|^2, and mean2 and (spread2 + 64 uu smax^2) |v| of the
+ * behind test (NaN when the camera lies within r, where the test does not apply), with uu
+ * taken at the band's shortest direction, which only makes the test stricter. */
+static inline int primary_cull(const double *pc, Ray *ray)
+{
+    double vd = pc[PC_V] * ray->d0 + pc[PC_V + 1] * ray->d1 + pc[PC_V + 2] * ray->d2;
+    if (pc[PC_VV] * ray->dd - vd * vd > pc[PC_R2] * ray->dd)  /* |v|^2 - (v.d)^2/|d|^2 > r^2, times |d|^2 */
+        return 1;
+    if (!(pc[PC_BEHIND] == pc[PC_BEHIND]))
+        return 0;
+    if (ray->len < 0)
+        ray->len = sqrt(ray->dd);
+    return -pc[PC_MEAN2] * vd - ray->len * pc[PC_BEHIND] > 0.015625;
+}
+
+/* dist: from the apex to the centre; directions between dmin and dmax long; 0: no claim. */
+static inline double depth_floor(double smin, double smax, double dist, double dmin, double dmax, double u,
+                                 double tiny)
+{
+    double dlo = smin * dmin;
+    if (!(dlo >= 0.0625))
+        return 0.0;
+    double uu = u + tiny / fmin(1.0, fmin(dlo * dlo, dmin * dmin));
+    double e = 32.0 * uu * (1.0 + smax / smin);  /* transform error, relative */
+    if (!(e < 0.25))
+        return 0.0;
+    double s_lo = smin * dist * (1.0 - BOUND_SLACK) * (1.0 - e), s_hi = smax * dist * (1.0 + BOUND_SLACK) * (1.0 + e);
+    double b_max = 2.0 * s_hi * (1.0 + 4.0 * uu), a_hi = 2.0 * (1.0 + 4.0 * uu);
+    double c_lo = 2.0 * (s_lo * s_lo - 1.0) - 8.0 * uu * (s_hi * s_hi + 1.0);
+    if (!(c_lo > 0))
+        return 0.0;
+    double alpha = pow(1.0 + uu, 4), beta = pow(1.0 - uu, 4), ac = 2.0 * (1.0 - 4.0 * uu) * c_lo;
+    double d_lo = dlo * (1.0 - e);
+    double b_min = sqrt(fmax(0.0, ((1.0 - uu) * ac - tiny / (d_lo * d_lo)) / (1.0 + uu)));
+    if (!(b_min > 0))
+        return 0.0;
+    double g_min = b_min - sqrt(fmax(0.0, alpha * b_min * b_min - beta * ac));
+    double g_max = b_max - sqrt(fmax(0.0, alpha * b_max * b_max - beta * ac));
+    double t_lo = (1.0 - uu) * (1.0 - uu) * fmin(g_min, g_max) / a_hi / (smax * (1.0 + e));
+    if (!(t_lo >= 2.0 * sqrt(tiny) * dmax))
+        return 0.0;
+    double floor = pow(1.0 - uu, 6) * (1.0 - 4.0 * uu) * t_lo * t_lo * (1.0 - BOUND_SLACK);
+    return isfinite(floor) ? floor : 0.0;
+}
+
+#endif

@@ -1,0 +1,202 @@
+/* The raytracer's compiled kernels (rend3r/emu/native.py loads them with ctypes).
+ *
+ * Built with the float semantics the emulator needs: no contraction of a*b+c into fused
+ * multiply-adds, no fast-math, IEEE subnormals (setup.py passes -ffp-contract=off).
+ * The datapath is written once (datapath.inc) and instantiated per working precision:
+ * _f32 (fp32), _h16 (fp16, subnormals flushed), _h16i (fp16, IEEE subnormals), _f64
+ * (fp64). Grid building and bounds work in double.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <math.h>
+#include <stdint.h>
+
+#include "bounds.h"
+#include "colour.h"
+#include "fround.h"
+#include "grids.h"
+#include "kernels.h"
+
+/* fp32: float operations round to float themselves. */
+#define W float
+#define FN(name) name##_f32
+#define R(x) (x)
+#define SQRTW sqrtf
+#include "datapath.inc"
+#undef FN
+#undef R
+
+/* fp16, subnormals flushed (the device's floating-point IP). */
+#define FN(name) name##_h16
+#define R(x) round16((x), 1)
+#include "datapath.inc"
+#undef FN
+#undef R
+
+/* fp16, IEEE gradual underflow. */
+#define FN(name) name##_h16i
+#define R(x) round16((x), 0)
+#include "datapath.inc"
+#undef W
+#undef FN
+#undef R
+#undef SQRTW
+
+/* fp64. */
+#define W double
+#define FN(name) name##_f64
+#define R(x) (x)
+#define SQRTW sqrt
+#include "datapath.inc"
+#undef W
+#undef FN
+#undef R
+#undef SQRTW
+
+/* ---- grids (rend3r/emu/grids.py) ---- */
+
+/* Range of a/c over a in [x - r, x + r], c in [z - r, z + r] (0 not in the latter):
+ * extreme at the corners. */
+static void ratio_range(double x, double z, double r, double *lo, double *hi)
+{
+    double a[2] = {x - r, x + r}, c[2] = {z - r, z + r};
+    *lo = INFINITY;
+    *hi = -INFINITY;
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2; j++) {
+            double q = a[i] / c[j];
+            *lo = fmin(*lo, q);
+            *hi = fmax(*hi, q);
+        }
+}
+
+/* The cell rectangle a ball (centre c relative to the apex, or projected (u, v) for a
+ * parallel grid; radius r) covers on a face: 0 when it covers none. Lines through the
+ * ball have (u, v) in the ratio box of its bounding cube, widened for float64 rounding. */
+static int footprint(const Grid *g, int parallel, int face, const double *c, double r, int64_t *out)
+{
+    const double *f = g->faces + GF_COLUMNS * face;
+    const int64_t *s = g->shape + GS_COLUMNS * face;
+    double ulo, uhi, vlo, vhi;
+    if (s[GS_NU] == 0)
+        return 0;
+    if (parallel) {
+        ulo = c[0] - r; uhi = c[0] + r; vlo = c[1] - r; vhi = c[1] + r;
+    } else {
+        double x = face == 0 ? c[1] : c[0], y = face == 2 ? c[1] : c[2], z = c[face];
+        if (z - r <= 0.0 && 0.0 <= z + r) {  /* the ball meets the plane through the apex */
+            ulo = f[GF_U0]; uhi = f[GF_U1]; vlo = f[GF_V0]; vhi = f[GF_V1];
+        } else {
+            ratio_range(x, z, r, &ulo, &uhi);
+            ratio_range(y, z, r, &vlo, &vhi);
+        }
+    }
+    ulo -= UV_SLACK * (1.0 + fabs(ulo)); vlo -= UV_SLACK * (1.0 + fabs(vlo));
+    uhi += UV_SLACK * (1.0 + fabs(uhi)); vhi += UV_SLACK * (1.0 + fabs(vhi));
+    if (!(ulo <= f[GF_U1] && uhi >= f[GF_U0] && vlo <= f[GF_V1] && vhi >= f[GF_V0]))
+        return 0;
+    out[0] = (int64_t)((fmax(ulo, f[GF_U0]) - f[GF_U0]) * f[GF_SU]);
+    out[1] = (int64_t)((fmin(uhi, f[GF_U1]) - f[GF_U0]) * f[GF_SU]);
+    out[2] = (int64_t)((fmax(vlo, f[GF_V0]) - f[GF_V0]) * f[GF_SV]);
+    out[3] = (int64_t)((fmin(vhi, f[GF_V1]) - f[GF_V0]) * f[GF_SV]);
+    if (out[1] > s[GS_NU] - 1) out[1] = s[GS_NU] - 1;
+    if (out[3] > s[GS_NV] - 1) out[3] = s[GS_NV] - 1;
+    if (out[0] > out[1]) out[0] = out[1];
+    if (out[2] > out[3]) out[2] = out[3];
+    return 1;
+}
+
+/* Per shape, the cells its footprint covers (-1: no finite radius, it goes global). */
+void grid_sizes(const Grid *g, int32_t parallel, const double *centers, const double *radii, int64_t n,
+                int64_t *sizes)
+{
+    for (int64_t s = 0; s < n; s++) {
+        if (!(radii[s] < INFINITY)) { sizes[s] = -1; continue; }
+        int64_t total = 0, box[4];
+        for (int face = 0; face < (parallel ? 1 : 3); face++)
+            if (footprint(g, parallel, face, centers + 3 * s, radii[s], box))
+                total += (box[1] - box[0] + 1) * (box[3] - box[2] + 1);
+        sizes[s] = total;
+    }
+}
+
+/* Count (fill == 0) or write (fill == 1, pos = each cell's next free entry) the listed
+ * shapes of order into their cells. */
+void grid_fill(const Grid *g, int32_t parallel, const double *centers, const double *radii, const int32_t *order,
+               int64_t n, const uint8_t *listed, int64_t *pos, int32_t *entries, int32_t fill)
+{
+    for (int64_t k = 0; k < n; k++) {
+        int32_t s = order[k];
+        if (!listed[s])
+            continue;
+        int64_t box[4];
+        for (int face = 0; face < (parallel ? 1 : 3); face++) {
+            if (!footprint(g, parallel, face, centers + 3 * (int64_t)s, radii[s], box))
+                continue;
+            const int64_t *gs = g->shape + GS_COLUMNS * face;
+            for (int64_t iv = box[2]; iv <= box[3]; iv++) {
+                int64_t row = gs[GS_FIRST] + iv * gs[GS_NU];
+                for (int64_t iu = box[0]; iu <= box[1]; iu++) {
+                    if (fill)
+                        entries[pos[row + iu]] = s;
+                    pos[row + iu]++;
+                }
+            }
+        }
+    }
+}
+
+/* ---- bounds per shape (rend3r/emu/bounds.py) ---- */
+
+void bound_radii(const double *bnd, const uint8_t *ok, const double *dist, int64_t n, double dmin, double u,
+                 double tiny, int32_t fp16, double *out)
+{
+    for (int64_t s = 0; s < n; s++) {
+        const double *b = bnd + B_COLUMNS * s;
+        out[s] = ok[s] ? cull_radius(b[B_SMIN], b[B_SMAX], dist[s], dmin, u, tiny, fp16) : INFINITY;
+    }
+}
+
+void bound_floors(const double *bnd, const uint8_t *ok, const double *dist, int64_t n, double dmin, double dmax,
+                  double u, double tiny, double *out)
+{
+    for (int64_t s = 0; s < n; s++) {
+        const double *b = bnd + B_COLUMNS * s;
+        out[s] = ok[s] ? depth_floor(b[B_SMIN], b[B_SMAX], dist[s], dmin, dmax, u, tiny) : 0.0;
+    }
+}
+
+/* The primary rays' cull data per shape (PC_COLUMNS, see primary_cull in bounds.h), for a
+ * camera at apex whose rays are at least dmin long; radius: the cull radii. */
+void bound_primary(const double *bnd, const double *radius, int64_t n, const double *apex, double dmin, double u,
+                   double tiny, double *out)
+{
+    for (int64_t s = 0; s < n; s++) {
+        const double *b = bnd + B_COLUMNS * s;
+        double *pc = out + PC_COLUMNS * s, r = radius[s], smin = b[B_SMIN], smax = b[B_SMAX];
+        double v0 = b[B_CENTER] - apex[0], v1 = b[B_CENTER + 1] - apex[1], v2 = b[B_CENTER + 2] - apex[2];
+        double vv = v0 * v0 + v1 * v1 + v2 * v2, dist = sqrt(vv);
+        double uu = u + tiny / fmin(1.0, (smin * dmin) * (smin * dmin));
+        pc[PC_V] = v0; pc[PC_V + 1] = v1; pc[PC_V + 2] = v2; pc[PC_VV] = vv;
+        pc[PC_R2] = r < INFINITY ? r * r * (1.0 + BOUND_SLACK) + 1e-12 * vv : INFINITY;
+        pc[PC_MEAN2] = (smax * smax + smin * smin) / 2.0;
+        pc[PC_BEHIND] = r < INFINITY && dist > r ? ((smax * smax - smin * smin) / 2.0 + 64.0 * uu * smax * smax) * dist
+                                                 : NAN;
+    }
+}
+
+/* ---- rounding, for tests ---- */
+
+void round16_array(const float *in, float *out, int64_t n, int32_t ftz)
+{
+    for (int64_t i = 0; i < n; i++)
+        out[i] = round16(in[i], ftz);
+}
+
+/* The library is loaded with ctypes; the module object only makes it importable. */
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_kernels", "rend3r's compiled raytracer kernels", -1, NULL, NULL, NULL, NULL, NULL,
+};
+
+PyMODINIT_FUNC PyInit__kernels(void) { return PyModule_Create(&module); }

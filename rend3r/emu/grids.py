@@ -1,0 +1,136 @@
+"""Ray-space grids: which shapes each ray must test, found in O(1) per ray.
+
+A bundle of rays either passes through one apex (primary rays through the camera; point
+light shadow rays, up to rounding, through the light) or is parallel (directional shadow
+rays). Each ray's *line* gets 2D coordinates (u, v):
+
+- perspective (apex A): the axis k of the direction's largest component picks one of
+  three faces, and (u, v) are the other two components over it (the same for d and -d,
+  so lines, not half-lines, as the cull radius is a statement about lines);
+- parallel (direction l): the ray's origin projected on two unit vectors normal to l.
+
+Over the rays' (u, v) bounding box per face lies a regular grid of about
+:data:`RAYS_PER_CELL` rays per cell. A shape with cull radius R (``docs/emulator.md`` 7.1)
+can only be hit by lines passing within R of its centre; their (u, v) lie in a box
+computed exactly (ratios of the intervals of the ball's bounding cube seen from the apex,
+extreme at corners; for a parallel bundle the centre's projection plus or minus R),
+widened for float64 rounding, and the shape is listed in every cell that box touches.
+Shapes without a finite radius, and the largest footprints when the lists would exceed
+their budget, go to one global list every ray tests. Lists keep the order given (front to
+back for primary rays, so a ray can stop at the first shape behind its nearest hit).
+
+A ray whose (u, v) falls outside the grid (only a ray the grid was not built from) or is
+not finite has cell -1 and tests every shape. The kernels are in ``csrc/grids.h`` and
+``csrc/kernels.c``.
+"""
+
+from __future__ import annotations
+
+import math
+from ctypes import byref
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import native
+
+RAYS_PER_CELL = 4
+#: Entries the cell lists may hold: this many per cell, within [MIN_BUDGET, MAX_BUDGET].
+ENTRIES_PER_CELL, MIN_BUDGET, MAX_BUDGET = 32, 1 << 22, 1 << 26
+MAX_CELLS_PER_AXIS = 4096
+#: Per face: u0, u1, v0, v1, rays, shortest and longest direction (as the kernels fill it).
+EMPTY_BOXES = np.tile(np.array([np.inf, -np.inf, np.inf, -np.inf, 0.0, np.inf, -np.inf]), (3, 1))
+
+
+@dataclass(frozen=True)
+class Grid:
+    """A built grid: per-face tables, CSR cell lists and the global list."""
+
+    faces: np.ndarray  # (3, GF_COLUMNS) float64
+    shape: np.ndarray  # (3, GS_COLUMNS) int64
+    start: np.ndarray  # (cells + 1,) int64
+    entries: np.ndarray  # int32 shape positions
+    glob: np.ndarray  # int32 shape positions every ray tests
+
+    def struct(self) -> native.Grid:
+        """The kernels' view (the arrays must outlive it)."""
+        return native.Grid(
+            native.ptr(self.faces, np.float64, (3, native.GF_COLUMNS)),
+            native.ptr(self.shape, np.int64, (3, native.GS_COLUMNS)), native.ptr(self.start, np.int64, (None,)),
+            native.ptr(self.entries, np.int32, (None,)), native.ptr(self.glob, np.int32, (None,)), len(self.glob))
+
+
+#: The grid of no rays: every lookup gives cell -1.
+EMPTY = Grid(np.zeros((3, native.GF_COLUMNS)), np.zeros((3, native.GS_COLUMNS), np.int64), np.zeros(1, np.int64),
+             np.zeros(0, np.int32), np.zeros(0, np.int32))
+
+
+def merge_boxes(boxes: np.ndarray) -> np.ndarray:
+    """Face boxes (k, 3, BOX_COLUMNS) of several chunks of rays merged into one (3, BOX_COLUMNS)."""
+    out = EMPTY_BOXES.copy()
+    for col, op in ((0, np.min), (1, np.max), (2, np.min), (3, np.max), (4, np.sum), (5, np.min), (6, np.max)):
+        out[:, col] = op(boxes[:, :, col], axis=0)
+    return out
+
+
+def _layout(boxes: np.ndarray, cells: float) -> tuple[np.ndarray, np.ndarray]:
+    """Face tables for about ``cells`` cells over the faces' boxes, shared by ray counts."""
+    faces = np.zeros((3, native.GF_COLUMNS))
+    shape = np.zeros((3, native.GS_COLUMNS), np.int64)
+    rays = boxes[:, 4]
+    first = 0
+    for k in np.flatnonzero(rays > 0):
+        u0, u1, v0, v1 = boxes[k, :4]
+        n = max(1.0, cells * rays[k] / rays.sum())
+        wu, wv = u1 - u0, v1 - v0
+        if wu > 0 and wv > 0:
+            nu = max(1, round(math.sqrt(n * wu / wv)))
+            nv = max(1, math.ceil(n / nu))
+        else:
+            nu, nv = (max(1, round(n)), 1) if wu > 0 else (1, max(1, round(n)) if wv > 0 else 1)
+        nu, nv = min(nu, MAX_CELLS_PER_AXIS), min(nv, MAX_CELLS_PER_AXIS)
+        faces[k] = (u0, u1, v0, v1, nu / wu if wu > 0 else 0.0, nv / wv if wv > 0 else 0.0)
+        shape[k] = (nu, nv, first)
+        first += nu * nv
+    return faces, shape
+
+
+def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndarray, order: np.ndarray) -> Grid:
+    """A grid over the rays' per-face ``boxes`` ((3, BOX_COLUMNS): u0, u1, v0, v1, rays, ...;
+    no rays: an unused face) listing shapes: ``centers`` (n, 3) relative to the apex, or
+    projected (u, v, 0) for a parallel bundle, cull ``radii``, listed in ``order``."""
+    n = len(radii)
+    centers = np.ascontiguousarray(centers, np.float64)
+    radii = np.ascontiguousarray(radii, np.float64)
+    order = np.ascontiguousarray(order, np.int32)
+    if len(order) != n or (n and not (0 <= order.min() and order.max() < n)) or centers.shape != (n, 3):
+        raise ValueError("grid: order must be a permutation of the shapes, centers (n, 3)")
+    lib = native.library()
+    cells = max(1.0, float(boxes[:, 4].sum()) / RAYS_PER_CELL)
+    sizes = np.empty(n, np.int64)
+    while True:
+        faces, shape = _layout(boxes, cells)
+        n_cells = int((shape[:, 0] * shape[:, 1]).sum())
+        grid = Grid(faces, shape, np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0, np.int32))
+        view = grid.struct()
+        lib.grid_sizes(byref(view), int(parallel), centers.ctypes.data, radii.ctypes.data, n, sizes.ctypes.data)
+        budget = min(MAX_BUDGET, max(MIN_BUDGET, ENTRIES_PER_CELL * n_cells))
+        listed = sizes >= 0
+        total = int(sizes[listed].sum())
+        if total <= budget or cells <= 1.0:
+            break
+        cells /= 4.0  # coarser cells: footprints shrink about as much
+    if total > budget:  # the largest footprints go to the global list
+        big = np.argsort(-sizes, kind="stable")[: int(listed.sum())]
+        left = total - np.cumsum(sizes[big])
+        listed[big[: int(np.searchsorted(-left, -budget)) + 1]] = False
+    flags = listed.astype(np.uint8)
+    counts = np.zeros(n_cells + 1, np.int64)
+    lib.grid_fill(byref(view), int(parallel), centers.ctypes.data, radii.ctypes.data, order.ctypes.data, n,
+                  flags.ctypes.data, counts[1:].ctypes.data, None, 0)
+    start = np.cumsum(counts)
+    entries = np.empty(int(start[-1]), np.int32)
+    pos = start[:-1].copy()
+    lib.grid_fill(byref(view), int(parallel), centers.ctypes.data, radii.ctypes.data, order.ctypes.data, n,
+                  flags.ctypes.data, pos.ctypes.data, entries.ctypes.data, 1)
+    return Grid(faces, shape, start, entries, order[~listed[order]])

@@ -1,0 +1,120 @@
+"""The compiled kernels (``rend3r/emu/csrc``), loaded with ctypes.
+
+The C extension ``rend3r.emu._kernels`` is built when rend3r is installed (``setup.py``),
+so nothing is compiled at run time. Calls through ctypes release the GIL: threads run
+kernels on every core. Argument blocks mirror ``csrc/kernels.h``; :func:`ptr` gives an
+array's address after checking its dtype and layout, so a kernel never sees an array of
+another type or shape than it was written for.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import importlib.util
+from ctypes import POINTER, Structure, c_double, c_int32, c_int64, c_void_p
+from functools import lru_cache
+
+import numpy as np
+
+from ..errors import Rend3rError
+
+# Column layouts shared with csrc/kernels.h.
+SF_LOC, SF_ROT, SF_INV, SF_ZSIGN, SF_ONE, SF_SHAT, SF_C2, SF_COLUMNS = 0, 3, 7, 10, 11, 12, 15, 16
+SI_IDENT, SI_COLOUR, SI_COLUMNS = 0, 1, 2
+B_CENTER, B_SMIN, B_SMAX, B_COLUMNS = 0, 3, 4, 5
+CAM_ORIGIN, CAM_TMIN, CAM_TMAX, CAM_Z, CAM_ROT, CAM_COLUMNS = 0, 3, 4, 5, 6, 10
+LT_KIND, LT_LOC, LT_DIR, LT_INTENSITY, LT_COLUMNS = 0, 1, 4, 7, 8
+LIGHT_DIRECTIONAL, LIGHT_POINT = 1, 2
+GF_COLUMNS, GS_COLUMNS, BOX_COLUMNS = 6, 3, 7
+TRACE_SHAPE_VALUES, TRACE_LIGHT_VALUES = 22, 12
+C_TESTS, C_NAN_TESTS, C_SHADOW_RAYS = 0, 1, 2
+PC_COLUMNS = 7
+
+
+class Shapes(Structure):
+    _fields_ = [("sf", c_void_p), ("si", c_void_p), ("bnd", c_void_p), ("n", c_int64), ("u", c_double),
+                ("tiny", c_double)]
+
+
+class Grid(Structure):
+    _fields_ = [("faces", c_void_p), ("shape", c_void_p), ("start", c_void_p), ("entries", c_void_p),
+                ("glob", c_void_p), ("nglob", c_int64)]
+
+
+class Band(Structure):
+    _fields_ = [("sh", POINTER(Shapes)), ("cam", c_void_p), ("xs", c_void_p), ("ys", c_void_p),
+                ("rotated", c_int32), ("lit", c_int32), ("width", c_int64), ("row0", c_int64), ("dirs", c_void_p),
+                ("col_cell", c_void_p), ("row_cell", c_void_p), ("pc", c_void_p), ("floor", c_void_p), ("grid", Grid), ("slot", c_void_p), ("sqd", c_void_p),
+                ("pt", c_void_p), ("nm", c_void_p), ("bad", c_void_p), ("nan_px", c_void_p)]
+
+
+class LightPass(Structure):
+    _fields_ = [("sh", POINTER(Shapes)), ("band", POINTER(Band)), ("light", c_void_p), ("scale", c_double * 3),
+                ("frame", c_double * 6), ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
+                ("along", c_void_p), ("radius", c_void_p), ("grid", Grid), ("acc", c_void_p)]
+
+
+def ptr(a: np.ndarray, dtype: type | np.dtype, shape: tuple[int | None, ...]) -> int:
+    """The address of ``a`` after checking its dtype, C-contiguity and shape (None: any)."""
+    if a.dtype != np.dtype(dtype) or not a.flags.c_contiguous or a.ndim != len(shape) or any(
+            want is not None and have != want for have, want in zip(a.shape, shape)):
+        raise TypeError(f"kernel argument: expected {np.dtype(dtype)} {shape}, got {a.dtype} {a.shape}")
+    return a.ctypes.data
+
+
+#: Kernel suffix per (precision, flush subnormals).
+SUFFIXES = {("fp16", True): "h16", ("fp16", False): "h16i", ("fp32", True): "f32", ("fp32", False): "f32",
+            ("fp64", True): "f64", ("fp64", False): "f64"}
+_SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix
+    "directions": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
+    "nearest": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
+    "origin_terms": (None, [POINTER(Shapes), c_void_p]),
+    "shadow_directions": (None, [POINTER(Shapes), c_void_p, c_void_p]),
+    "light_pass": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
+    "shadow_origins": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
+    "trace_pixel": (c_int64, [POINTER(Band), POINTER(LightPass), c_void_p, c_void_p, c_int64, c_int64, c_int64,
+                              c_void_p, c_void_p, c_void_p]),
+    "finish": (c_int64, [POINTER(Band), c_void_p, c_void_p, c_int32, c_int64, c_int64, c_void_p, c_void_p,
+                         c_void_p]),
+}
+_PLAIN = {
+    "grid_sizes": (None, [POINTER(Grid), c_int32, c_void_p, c_void_p, c_int64, c_void_p]),
+    "grid_fill": (None, [POINTER(Grid), c_int32, c_void_p, c_void_p, c_void_p, c_int64, c_void_p, c_void_p,
+                         c_void_p, c_int32]),
+    "bound_radii": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_int32, c_void_p]),
+    "bound_floors": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double,
+                            c_void_p]),
+    "bound_primary": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_void_p]),
+    "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
+}
+
+
+@lru_cache(maxsize=1)
+def library() -> ctypes.CDLL:
+    """The kernels' shared library, with every function's argument types declared."""
+    spec = importlib.util.find_spec("rend3r.emu._kernels")
+    if spec is None or spec.origin is None:
+        raise Rend3rError("rend3r's compiled kernels are missing: reinstall it (python -m pip install -e .), "
+                          "which needs a C compiler")
+    lib = ctypes.CDLL(spec.origin)
+    table = dict(_PLAIN)
+    for name, sig in _SUFFIXED.items():
+        for suffix in set(SUFFIXES.values()):
+            table[f"{name}_{suffix}"] = sig
+    for name, (restype, argtypes) in table.items():
+        fn = getattr(lib, name)
+        fn.restype, fn.argtypes = restype, argtypes
+    return lib
+
+
+def kernel(name: str, precision: str, ftz: bool) -> ctypes._CFuncPtr:
+    """The kernel ``name`` compiled for a working precision and subnormal handling."""
+    return getattr(library(), f"{name}_{SUFFIXES[precision, ftz]}")
+
+
+def round16(values: np.ndarray, ftz: bool) -> np.ndarray:
+    """float32 values rounded to float16 by the kernels' rounding (for tests)."""
+    a = np.ascontiguousarray(values, np.float32)
+    out = np.empty_like(a)
+    library().round16_array(a.ctypes.data, out.ctypes.data, a.size, int(ftz))
+    return out

@@ -1,0 +1,123 @@
+"""The bounds behind the raytracer's grids are sound, and the grids change no pixel.
+
+Rays are aimed at and around random ellipsoids in every precision and computed with the
+reference raycaster: every computed hit lies within the cull radius of its line and no
+nearer than the depth floor. Deep scenes (front spheres hiding columns behind them) render
+as the reference renders them, while testing a small share of the pairs.
+"""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from rend3r.emu import bounds
+from rend3r.emu.arith import make_arith
+from rend3r.emu.options import EmuOptions
+from rend3r.emu.processor import execute
+from rend3r.emu.raytracer import render_frame
+from rend3r.emu.reference import render_reference
+from rend3r.emu.shapes import SPHERE, origin_term, shapes_from_scene, solve, squared_distance, to_object
+
+from .scenes import Prog
+
+ARITHS = [("fp16", "ftz"), ("fp16", "ieee"), ("fp32", "ftz"), ("fp64", "ftz")]
+coord = st.floats(-3, 3, allow_nan=False, width=16)
+
+
+def _scene(prog: Prog):
+    scenes = []
+    execute(prog.nf().words, EmuOptions(), on_nf=lambda s, n: scenes.append(s))
+    return scenes[0]
+
+
+def _rays(ar, center, origin, radius, rng, count=4000):
+    """Directions (working precision) aimed at and around a centre from an origin."""
+    aim = (center - origin) + rng.normal(size=(count, 3)) * radius * rng.uniform(0.2, 1.5)
+    aim *= rng.uniform(0.5, 4.0, size=(count, 1))
+    return tuple(ar.round(aim[:, k].astype(ar.dtype)) for k in range(3))
+
+
+@settings(max_examples=60)
+@given(st.sampled_from(ARITHS), st.tuples(coord, coord, st.floats(-12, -2, allow_nan=False, width=16)),
+       st.floats(0.25, 4.0, width=16), st.floats(0.75, 1.25, width=16),
+       st.tuples(*[st.floats(-1, 1, allow_nan=False, width=16)] * 4), st.tuples(coord, coord), st.integers(0, 2**31))
+def test_every_computed_hit_is_within_the_cull_radius_and_beyond_the_depth_floor(arith, loc, inv, stretch, q, cam,
+                                                                                  seed):
+    ar = make_arith(*arith)
+    rot = q if any(abs(c) > 0.05 for c in q) else (1.0, 0.0, 0.0, 0.0)
+    scene = _scene(Prog().nr().cam(xloc=cam[0], yloc=cam[1]).sphere(0, loc=loc, scale=(inv, inv * stretch, inv), rot=rot))
+    shapes = shapes_from_scene(scene, ar)
+    origin = tuple(ar.from_bits(scene.camera_bits(n)) for n in ("xloc", "yloc", "zloc"))
+    o64 = np.array([float(c) for c in origin])
+    table, ok = bounds.shape_bounds(np.array([[float(c[0]) for c in shapes.loc]]),
+                                    np.array([[float(c[0]) for c in shapes.rot]]),
+                                    np.array([[float(c[0]) for c in shapes.inv_scale]]), shapes.kind == SPHERE)
+    center = table[0, :3]
+    d = _rays(ar, center, o64, 1.0 / (inv * min(1.0, stretch)), np.random.default_rng(seed))
+    d64 = np.stack([np.asarray(c, np.float64) for c in d], axis=1)
+    length = np.linalg.norm(d64, axis=1)
+    dist = np.array([np.linalg.norm(center - o64)])
+    radius = bounds.cull_radii(table, ok, dist, length.min(), ar.unit_roundoff, ar.tiny, ar.precision == "fp16")[0]
+    floor = bounds.depth_floors(table, ok, dist, length.min(), length.max(), ar.unit_roundoff, ar.tiny)[0]
+    s = shapes.take(0)
+    S, D = to_object(ar, s, origin, d)
+    sol = solve(ar, s, S, D, origin_term(ar, s, S), ar.const(0.0), ar.const(np.inf))
+    sqd = squared_distance(ar, ar.add(ar.add(ar.mul(d[0], d[0]), ar.mul(d[1], d[1])), ar.mul(d[2], d[2])), sol.t)
+    hit = sol.hit & np.isfinite(sqd)
+    v = center - o64
+    gap = np.sqrt(np.maximum(0.0, v @ v - (d64 @ v) ** 2 / length**2))
+    assert (gap[sol.disc >= 0] <= radius).all()  # a real root only near the line
+    assert (np.asarray(sqd[hit], np.float64) >= floor).all()
+
+
+def _deep(n=4, k=4, depth_step=0.6, inv=2.4, **cam) -> Prog:
+    """An n x n wall of columns k deep: front spheres hide most of the ones behind."""
+    p = Prog().nr().cam(hfov=0.25, vfov=0.25, **cam)
+    spacing = 4.0 / n
+    for i in range(n):
+        for j in range(n):
+            for d in range(k):
+                x, y = (i - (n - 1) / 2) * spacing, (j - (n - 1) / 2) * spacing
+                p.sphere(((i * n) + j) * k + d, loc=(x, y, -3.0 - d * depth_step), scale=(inv / spacing,) * 3,
+                         col=(i * 4 + j * 2 + d) & 0xFFFF or 1)
+    return p
+
+
+def _same(prog: Prog, options: EmuOptions):
+    scene = _scene(prog)
+    engine, stats = render_frame(scene, options)
+    ref = render_reference(scene, options)
+    assert (engine.rgb565 == ref.rgb565).all()
+    assert (engine.provenance == ref.provenance).all()
+    assert (engine.depth.view(np.uint32) == ref.depth.view(np.uint32)).all()
+    return stats
+
+
+@pytest.mark.parametrize("precision,subnormals", ARITHS)
+@pytest.mark.parametrize("cam", [{}, {"rrot": 0.96, "jrot": 0.1, "irot": -0.05}], ids=["grid", "rotated"])
+def test_deep_scenes_render_as_the_reference_with_few_tests(precision, subnormals, cam):
+    prog = _deep(n=8, k=5, **cam).dir_light(0, forward=(0.3, -0.2, -1.0)).light(1, src=2, xloc=0.5, yloc=2.0, zloc=1.0)
+    stats = _same(prog, EmuOptions(width=80, height=60, precision=precision, subnormals=subnormals))
+    assert stats.tests < stats.skipped / 10
+
+
+@pytest.mark.parametrize("precision,per_pixel", [("fp16", 3), ("fp32", 1.1), ("fp64", 1.1)])
+def test_shapes_behind_the_nearest_hit_are_not_tested(precision, per_pixel):
+    """A column of 40 spheres straight ahead: a pixel stops after the first ones (the
+    float16 depth floor is looser)."""
+    p = Prog().nr().cam(hfov=0.08, vfov=0.08)
+    for d in range(40):
+        p.sphere(d, loc=(0.0, 0.0, -3.0 - 0.5 * d), col=0x0841 * (d % 31 + 1))
+    stats = _same(p, EmuOptions(width=40, height=30, precision=precision))
+    assert stats.hits > 800
+    assert stats.tests < per_pixel * stats.hits
+
+
+def test_equal_spheres_at_equal_depth_keep_the_lower_index():
+    p = Prog().nr().cam(hfov=0.3, vfov=0.3)
+    for i in range(6):
+        p.sphere(10 - i, loc=(0.0, 0.0, -4.0), col=0x1000 + i)
+    p.sphere(20, loc=(0.0, 0.0, -9.0), col=0xFFFF)
+    _same(p, EmuOptions(width=40, height=30))
+    frame, _ = render_frame(_scene(p), EmuOptions(width=40, height=30))
+    assert set(np.unique(frame.provenance)) <= {-1, 5}

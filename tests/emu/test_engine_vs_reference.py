@@ -1,0 +1,190 @@
+"""The compiled raytracer against the plain reference renderer (every pixel against every
+shape, numpy): identical pixels, depth bits and provenance on random scenes.
+
+Scenes mix every shape type (and types that are off), rotations, scales, both cameras,
+directional and point lights, every precision with flushed and gradual underflow, the
+original board's profile, exact ties (duplicated shapes), and float16 operands that are
+infinite, NaN, subnormal, zero of either sign or the largest finite value. About 600
+scenes run in CI (fixed seed); ``benchmarks/fuzz_engine.py`` runs more.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from hypothesis import event, given, settings, strategies as st
+
+from rend3r.emu.frame import Frame
+from rend3r.emu.options import EmuOptions
+from rend3r.emu.processor import execute
+from rend3r.emu.quirks import apply_quirks, quirk_names
+from rend3r.emu.raytracer import render_frame
+from rend3r.emu.reference import render_reference
+from rend3r.emu.scene import Scene
+from rend3r.isa import CameraSet, FrameOp, Func, LightSet, ShapeSet, Table, ValueType, encode, lookup
+from rend3r.isa.float16 import float_to_bits
+
+SPECIAL = [0x0000, 0x8000, 0x0001, 0x03FF, 0x8200, 0x0400, 0x7BFF, 0xFBFF, 0x7C00, 0xFC00, 0x7E00, 0x3C00, 0xBC00]
+
+
+def f16(lo: float, hi: float, special: float = 0.03) -> st.SearchStrategy[int]:
+    """float16 bits: a value in [lo, hi], or with probability ``special`` a special value."""
+    lo, hi = float(np.float16(lo)), float(np.float16(hi))
+    nice = st.floats(lo, hi, allow_nan=False, width=16).map(float_to_bits)
+    return st.floats(0, 1).flatmap(lambda p: st.sampled_from(SPECIAL) if p < special else nice)
+
+
+def quaternion(special: float = 0.03) -> st.SearchStrategy[tuple[int, ...]]:
+    turned = st.tuples(*[f16(-1.5, 1.5, special)] * 4)
+    return st.one_of(st.just((0x3C00, 0, 0, 0)), st.just((0, 0, 0, 0)), turned)
+
+
+#: A shape aimed into the view: frame position (a, b) in [0, 1], distance t along that
+#: pixel's ray, radius as a fraction of the distance, per-axis stretch; then properties
+#: written as they are (type, colour, rotation) and, sometimes, one special value.
+shape = st.fixed_dictionaries({
+    "type": st.sampled_from([1, 1, 1, 2, 3, 0, 5]),
+    "col": st.integers(0, 0xFFFF),
+    "aim": st.tuples(st.floats(0.1, 0.9), st.floats(0.1, 0.9), st.floats(1.5, 30), st.floats(0.08, 0.4)),
+    "stretch": st.tuples(*[st.floats(0.7, 1.5)] * 3),
+    "rot": quaternion(),
+    "special": st.sampled_from([None] * 6 + [(n, v) for n in ("xloc", "yloc", "zloc", "xscl", "yscl", "zscl")
+                                             for v in SPECIAL]),
+})
+light = st.one_of(
+    st.fixed_dictionaries({"src": st.just(1), "xfor": f16(-2, 2), "yfor": f16(-2, 2), "zfor": f16(-2, 2),
+                           "col": st.integers(0, 0xFFFF), "int": f16(0, 2)}),
+    st.fixed_dictionaries({"src": st.just(2), "xloc": f16(-8, 8), "yloc": f16(-8, 8), "zloc": f16(-30, 5),
+                           "int": f16(0, 2)}),
+    st.fixed_dictionaries({"src": st.sampled_from([0, 3])}),
+)
+camera = st.fixed_dictionaries({
+    "xloc": f16(-2, 2, 0.02), "yloc": f16(-2, 2, 0.02), "zloc": f16(-2, 2, 0.02),
+    "rot": st.one_of(st.just((0, 0, 0, 0)), quaternion(0.02)),
+    "hfov": st.one_of(st.just(0), f16(0.05, 0.6, 0.02)), "vfov": st.one_of(st.just(0), f16(0.05, 0.6, 0.02)),
+    "nclip": st.one_of(st.just(0), f16(0.05, 4, 0.02)), "fclip": st.one_of(st.just(0), f16(1, 60, 0.02)),
+})
+precision = st.sampled_from([("fp16", "ftz"), ("fp16", "ieee"), ("fp32", "ftz"), ("fp64", "ftz")])
+
+
+def _prop(table: Table, name: str) -> int:
+    return lookup(table, name).index
+
+
+def _value(bits: int, default: float) -> float:
+    v = float(np.uint16(bits).view(np.float16))
+    return default if v == 0 else v
+
+
+def _aim(cam: dict, options: EmuOptions, a: float, b: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """The camera's origin, the direction through frame position (a, b) and the frame's
+    width at t = 1, in float64 and unrounded: where to put a shape so that it shows."""
+    origin = np.array([_value(cam[n], 0.0) for n in ("xloc", "yloc", "zloc")])
+    if options.camera == "device":
+        x0, y0, step = -4.98828125, -3.740234375, 0.01953125
+        d = np.array([x0 + a * options.width * step, y0 + b * options.height * step, -1.0])
+        return origin, d, options.width * step
+    near = _value(cam["nclip"], 1.0)
+    d = np.array([10 * (a - 0.5) * _value(cam["hfov"], 1.0) * near, 7.5 * (0.5 - b) * _value(cam["vfov"], 1.0) * near,
+                  -near])
+    q = np.array([float(np.uint16(c).view(np.float16)) for c in cam["rot"]])
+    with np.errstate(all="ignore"):
+        if q[1:].any():
+            r, i, j, k = q / np.linalg.norm(q)
+            rot = np.array([[1 - 2 * (j * j + k * k), 2 * (i * j - k * r), 2 * (i * k + j * r)],
+                            [2 * (i * j + k * r), 1 - 2 * (i * i + k * k), 2 * (j * k - i * r)],
+                            [2 * (i * k - j * r), 2 * (j * k + i * r), 1 - 2 * (i * i + j * j)]])
+            d = rot @ d
+    return origin, d, abs(10 * _value(cam["hfov"], 1.0) * near)
+
+
+def program(cam: dict, lights: list[dict], shapes: list[dict], ties: list[int], options: EmuOptions) -> list[int]:
+    """nr, the camera, lights and shapes (``ties``: shapes repeated at higher indices), nf."""
+    words = list(encode(FrameOp(Func.NR)))
+    for name, value in cam.items():
+        names = ("rrot", "irot", "jrot", "krot") if name == "rot" else (name,)
+        for n, v in zip(names, value if name == "rot" else (value,)):
+            words += encode(CameraSet(_prop(Table.CAMERA, n), v))
+    for i, lt in enumerate(lights):
+        for name, v in lt.items():
+            words += encode(LightSet(i, _prop(Table.LIGHT, name), v))
+    for i, sh in enumerate(shapes + [shapes[k % len(shapes)] for k in ties]):
+        a, b, t, size = sh["aim"]
+        origin, d, width = _aim(cam, options, a, b)
+        with np.errstate(all="ignore"):
+            loc = origin + t * d
+            inv = 1 / (size * t * width * np.array(sh["stretch"]))
+        props = {"type": sh["type"], "col": sh["col"], **dict(zip(("rrot", "irot", "jrot", "krot"), sh["rot"])),
+                 **{n: float_to_bits(float(v)) for n, v in zip(("xloc", "yloc", "zloc"), loc)},
+                 **{n: float_to_bits(float(v)) for n, v in zip(("xscl", "yscl", "zscl"), inv)}}
+        if sh["special"] is not None:
+            props[sh["special"][0]] = sh["special"][1]
+        items = list(props.items())
+        for (n1, v1), (n2, v2) in zip(items[::2], items[1::2] + [("zero", 0)] * (len(items) % 2)):
+            words += encode(ShapeSet(3 * i + 1, _prop(Table.SHAPE, n1), _prop(Table.SHAPE, n2), v1, v2))
+    return words + list(encode(FrameOp(Func.NF)))
+
+
+def scene_of(words: list[int], options: EmuOptions) -> Scene:
+    scenes: list[Scene] = []
+    execute(words, options, on_nf=lambda scene, n: scenes.append(scene))
+    return scenes[0]
+
+
+def assert_same(a: Frame, b: Frame) -> None:
+    assert (a.provenance == b.provenance).all(), np.argwhere(a.provenance != b.provenance)[:5]
+    assert (a.rgb565 == b.rgb565).all(), np.argwhere(a.rgb565 != b.rgb565)[:5]
+    assert (a.depth.view(np.uint32) == b.depth.view(np.uint32)).all()
+
+
+def check(words: list[int], options: EmuOptions) -> None:
+    scene = scene_of(words, options)
+    engine, stats = render_frame(scene, options)
+    event(f"pixels hit: {'none' if not stats.hits else 'some' if stats.hits < options.pixels // 4 else 'many'}")
+    assert_same(engine, render_reference(scene, options))
+    split, _ = render_frame(scene, replace(options, jobs=3))
+    assert_same(engine, split)
+
+
+scene_args = (camera, st.lists(light, max_size=3), st.lists(shape, min_size=1, max_size=7),
+              st.lists(st.integers(0, 6), max_size=2), precision)
+
+
+@settings(max_examples=400, derandomize=True)
+@given(*scene_args)
+def test_random_scenes(cam, lights, shapes, ties, prec):
+    options = EmuOptions(precision=prec[0], subnormals=prec[1], width=24, height=18)
+    check(program(cam, lights, shapes, ties, options), options)
+
+
+@settings(max_examples=100, derandomize=True)
+@given(camera, st.lists(light, min_size=1, max_size=3).filter(lambda ls: ls[0]["src"] == 1),
+       *scene_args[2:], st.booleans())
+def test_random_scenes_on_the_original_board(cam, lights, shapes, ties, prec, ieee):
+    """The board lights every point with light 0 as a directional light."""
+    options = apply_quirks(EmuOptions(precision=prec[0], width=24, height=18), quirk_names("rend3r-2022", []))
+    options = replace(options, subnormals="ieee" if ieee else options.subnormals)
+    check(program(cam, lights, shapes, ties, options), options)
+
+
+@settings(max_examples=100, derandomize=True)
+@given(st.integers(1, 6), st.integers(1, 4), st.floats(0.02, 0.12), st.floats(2, 12), st.lists(light, min_size=1, max_size=2),
+       quaternion(0), precision)
+def test_random_walls(g, k, size, distance, lights, rot, prec):
+    """Many spheres in view, in front of each other: grids with several shapes per cell,
+    depth order, shadows cast by neighbours."""
+    cam = {"xloc": 0, "yloc": 0, "zloc": 0, "rot": (0, 0, 0, 0), "hfov": float_to_bits(0.4),
+           "vfov": float_to_bits(0.4), "nclip": 0, "fclip": 0}
+    shapes = [{"type": 1, "col": 0x1234 * (i + 1) & 0xFFFF, "rot": rot, "stretch": (1.0, 1.0, 1.0), "special": None,
+               "aim": (0.5 + ((i % g) - (g - 1) / 2) / (g + 1), 0.5 + ((i // g % g) - (g - 1) / 2) / (g + 1),
+                       distance * (1 + 0.15 * (i // (g * g))), size)} for i in range(g * g * k)]
+    options = EmuOptions(precision=prec[0], subnormals=prec[1], width=24, height=18)
+    check(program(cam, lights, shapes, [], options), options)
+
+
+def test_value_types_are_what_the_tables_say():
+    """The strategies write float16 bits to float properties and ints to int properties."""
+    assert lookup(Table.SHAPE, "type").vtype is ValueType.INT
+    assert lookup(Table.SHAPE, "xloc").vtype is ValueType.FLOAT16
+    assert lookup(Table.LIGHT, "src").vtype is ValueType.INT

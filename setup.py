@@ -4,7 +4,8 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 #: IEEE semantics the emulator depends on: no fused multiply-adds, no fast-math.
-UNIX_FLAGS = ["-std=c11", "-O2", "-ffp-contract=off", "-fno-fast-math", "-fno-math-errno", "-Wall", "-Wextra"]
+UNIX_FLAGS = ["-std=c11", "-O3", "-ffp-contract=off", "-fno-fast-math", "-fno-math-errno", "-Wall", "-Wextra",
+              "-Wno-psabi"]
 MSVC_FLAGS = ["/O2", "/fp:precise"]
 
 
@@ -22,8 +23,10 @@ setup(
     ext_modules=[
         Extension(
             "rend3r.emu._kernels",
-            sources=["rend3r/emu/csrc/kernels.c"],
-            depends=[f"rend3r/emu/csrc/{name}" for name in ("bounds.h", "colour.h", "datapath.inc", "fround.h", "grids.h", "kernels.h")],
+            sources=["rend3r/emu/csrc/kernels.c", "rend3r/emu/csrc/kernels_avx2.c"],
+            depends=[f"rend3r/emu/csrc/{name}" for name in (
+                "bounds.h", "colour.h", "cull.h", "datapath.inc", "fround.h", "grids.h", "instances.inc", "kernels.h",
+                "simd.h")],
         )
     ],
     cmdclass={"build_ext": BuildKernels},

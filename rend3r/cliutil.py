@@ -1,4 +1,4 @@
-"""Option parsing shared by the commands: image sizes ``WxH``."""
+"""Option parsing shared by the commands: image sizes ``WxH``, thread counts."""
 
 from __future__ import annotations
 
@@ -39,3 +39,8 @@ class SizeType(click.ParamType):
 
 #: The shared instance: ``@click.option("--size", type=SIZE, default="512x384")``.
 SIZE = SizeType()
+
+
+#: ``--jobs N``: threads rendering each frame (0, the default: every core this process may use).
+JOBS = click.option("--jobs", type=click.IntRange(0, 256), default=0, show_default=True, metavar="N",
+                    help="Threads rendering each frame; 0 uses every core. The image does not depend on it.")

@@ -8,7 +8,7 @@ import sys
 
 import click
 
-from ..cliutil import SIZE
+from ..cliutil import JOBS, SIZE
 from ..errors import Rend3rError
 
 _EPILOG = """\b
@@ -16,6 +16,7 @@ Examples:
   rend3r emulate programs/sphere.asm -o sphere.png
   rend3r emulate programs/animation.asm --frames 24 -o out/frame_{n:03}.png --gif anim.gif
   rend3r emulate sphere.mem -o s.png --precision fp32 --size 256x192 --depth-image d.png --stats
+  rend3r emulate programs/stress4096.asm -o s.png --jobs 1
   rend3r emulate programs/tri_cube.asm -o cube.png --depth painter
   rend3r emulate programs/sphere.asm -o board.png --profile rend3r-2022 --trace-pixel 252,188 --trace t.jsonl
 """
@@ -52,9 +53,10 @@ def _colour(ctx, param, value: str) -> int:
 @click.option("--device-quirk", "quirks", multiple=True, metavar="NAME", help="Switch on one device quirk (repeatable); names in docs/device-profile.md.")
 @click.option("--trace-pixel", "trace_pixels", multiple=True, metavar="X,Y", help="Trace every float16 intermediate of this pixel (repeatable; docs/trace.md).")
 @click.option("--trace", "trace_path", help="Write pixel traces (JSON lines) to FILE instead of standard output.")
+@JOBS
 def emulate_command(program, output, frames, mode, precision, subnormals, size, background, visibility,
                     depth_path, prov_path, gif_path, apng_path, show_stats, profile, quirks, trace_pixels,
-                    trace_path) -> None:
+                    trace_path, jobs) -> None:
     """Run a REND3R PROGRAM (source or memory image) and render its frames."""
     from .image import (ANIMATION_KINDS, DATA_KINDS, FRAME_KINDS, check_output, frame_path, is_pattern,
                         save_animation, save_depth, save_png, save_provenance)
@@ -83,7 +85,7 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
         raise Rend3rError(f"{trace_path}: folder {os.path.dirname(trace_path)} does not exist")
     loaded = load_program(program)
     options = EmuOptions(precision=precision, subnormals=subnormals, mode=mode or loaded.mode_hint or "raytrace",
-                         width=size[0], height=size[1], background=background, depth=visibility)
+                         width=size[0], height=size[1], background=background, depth=visibility, jobs=jobs)
     options = apply_quirks(options, quirk_names(profile, quirks))
     for x, y in pixels:
         if not (0 <= x < options.width and 0 <= y < options.height):

@@ -34,7 +34,7 @@ import numpy as np
 
 from . import native
 
-RAYS_PER_CELL = 4
+RAYS_PER_CELL = 8
 #: Entries the cell lists may hold: this many per cell, within [MIN_BUDGET, MAX_BUDGET].
 ENTRIES_PER_CELL, MIN_BUDGET, MAX_BUDGET = 32, 1 << 22, 1 << 26
 MAX_CELLS_PER_AXIS = 4096
@@ -43,21 +43,58 @@ EMPTY_BOXES = np.tile(np.array([np.inf, -np.inf, np.inf, -np.inf, 0.0, np.inf, -
 
 
 @dataclass(frozen=True)
+class PixelLayout:
+    """Cells of a grid camera: runs of ``block`` columns of one row. ``u`` holds each
+    column's u = x/z and ``v`` each row's v = y/z (both monotonic), as the rays' lines have
+    them on face 2."""
+
+    u: np.ndarray
+    v: np.ndarray
+    block: int = 8
+
+    @classmethod
+    def of(cls, u: np.ndarray, v: np.ndarray) -> "PixelLayout | None":
+        """The layout, or None when u or v is not finite and monotonic."""
+        for a in (u, v):
+            if not (np.isfinite(a).all() and ((np.diff(a) >= 0).all() or (np.diff(a) <= 0).all())):
+                return None
+        return cls(u, v)
+
+    @staticmethod
+    def oriented(a: np.ndarray) -> tuple[np.ndarray, float]:
+        """(sign * a ascending, sign)."""
+        sign = 1.0 if len(a) < 2 or a[-1] >= a[0] else -1.0
+        return np.ascontiguousarray(sign * a), sign
+
+
+@dataclass(frozen=True)
 class Grid:
-    """A built grid: per-face tables, CSR cell lists and the global list."""
+    """A built grid: per-face tables, CSR cell lists, the global list, and for a grid
+    camera its pixel layout."""
 
     faces: np.ndarray  # (3, GF_COLUMNS) float64
     shape: np.ndarray  # (3, GS_COLUMNS) int64
     start: np.ndarray  # (cells + 1,) int64
     entries: np.ndarray  # int32 shape positions
     glob: np.ndarray  # int32 shape positions every ray tests
+    layout: tuple[np.ndarray, float, np.ndarray, float, int] | None = None  # u_at, u_sign, v_at, v_sign, block
 
     def struct(self) -> native.Grid:
         """The kernels' view (the arrays must outlive it)."""
-        return native.Grid(
+        view = native.Grid(
             native.ptr(self.faces, np.float64, (3, native.GF_COLUMNS)),
             native.ptr(self.shape, np.int64, (3, native.GS_COLUMNS)), native.ptr(self.start, np.int64, (None,)),
-            native.ptr(self.entries, np.int32, (None,)), native.ptr(self.glob, np.int32, (None,)), len(self.glob))
+            len(self.start), native.ptr(self.entries, np.int32, (None,)), native.ptr(self.glob, np.int32, (None,)),
+            len(self.glob))
+        if self.layout is not None:
+            u_at, view.u_sign, v_at, view.v_sign, view.block = self.layout
+            view.u_at, view.v_at = native.ptr(u_at, np.float64, (None,)), native.ptr(v_at, np.float64, (None,))
+            view.n_u, view.n_v = len(u_at), len(v_at)
+        return view
+
+    @property
+    def cells(self) -> int:
+        return len(self.start) - 1
 
 
 #: The grid of no rays: every lookup gives cell -1.
@@ -95,10 +132,24 @@ def _layout(boxes: np.ndarray, cells: float) -> tuple[np.ndarray, np.ndarray]:
     return faces, shape
 
 
-def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndarray, order: np.ndarray) -> Grid:
+def _pixel_faces(pixels: PixelLayout) -> tuple[np.ndarray, np.ndarray, tuple]:
+    """Face tables and the kernels' layout tuple of a grid camera's pixel grid (face 2)."""
+    faces = np.zeros((3, native.GF_COLUMNS))
+    shape = np.zeros((3, native.GS_COLUMNS), np.int64)
+    faces[2, :4] = pixels.u.min(), pixels.u.max(), pixels.v.min(), pixels.v.max()
+    shape[2] = (-(-len(pixels.u) // pixels.block), len(pixels.v), 0)
+    u_at, u_sign = PixelLayout.oriented(pixels.u)
+    v_at, v_sign = PixelLayout.oriented(pixels.v)
+    return faces, shape, (u_at, u_sign, v_at, v_sign, pixels.block)
+
+
+def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndarray, order: np.ndarray,
+          pixels: PixelLayout | None = None, rays_per_cell: int = RAYS_PER_CELL) -> Grid:
     """A grid over the rays' per-face ``boxes`` ((3, BOX_COLUMNS): u0, u1, v0, v1, rays, ...;
     no rays: an unused face) listing shapes: ``centers`` (n, 3) relative to the apex, or
-    projected (u, v, 0) for a parallel bundle, cull ``radii``, listed in ``order``."""
+    projected (u, v, 0) for a parallel bundle, cull ``radii``, listed in ``order``. With
+    ``pixels`` (a grid camera), the cells are its runs of pixels; else about
+    ``rays_per_cell`` rays share a cell."""
     n = len(radii)
     centers = np.ascontiguousarray(centers, np.float64)
     radii = np.ascontiguousarray(radii, np.float64)
@@ -106,18 +157,18 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
     if len(order) != n or (n and not (0 <= order.min() and order.max() < n)) or centers.shape != (n, 3):
         raise ValueError("grid: order must be a permutation of the shapes, centers (n, 3)")
     lib = native.library()
-    cells = max(1.0, float(boxes[:, 4].sum()) / RAYS_PER_CELL)
+    cells = max(1.0, float(boxes[:, 4].sum()) / rays_per_cell)
     sizes = np.empty(n, np.int64)
     while True:
-        faces, shape = _layout(boxes, cells)
+        faces, shape, layout = _pixel_faces(pixels) if pixels is not None else (*_layout(boxes, cells), None)
         n_cells = int((shape[:, 0] * shape[:, 1]).sum())
-        grid = Grid(faces, shape, np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0, np.int32))
+        grid = Grid(faces, shape, np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0, np.int32), layout)
         view = grid.struct()
         lib.grid_sizes(byref(view), int(parallel), centers.ctypes.data, radii.ctypes.data, n, sizes.ctypes.data)
         budget = min(MAX_BUDGET, max(MIN_BUDGET, ENTRIES_PER_CELL * n_cells))
         listed = sizes >= 0
         total = int(sizes[listed].sum())
-        if total <= budget or cells <= 1.0:
+        if total <= budget or cells <= 1.0 or pixels is not None:
             break
         cells /= 4.0  # coarser cells: footprints shrink about as much
     if total > budget:  # the largest footprints go to the global list
@@ -133,4 +184,4 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
     pos = start[:-1].copy()
     lib.grid_fill(byref(view), int(parallel), centers.ctypes.data, radii.ctypes.data, order.ctypes.data, n,
                   flags.ctypes.data, pos.ctypes.data, entries.ctypes.data, 1)
-    return Grid(faces, shape, start, entries, order[~listed[order]])
+    return Grid(faces, shape, start, entries, order[~listed[order]], layout)

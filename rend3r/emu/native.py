@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import ctypes
 import importlib.util
-from ctypes import POINTER, Structure, c_double, c_int32, c_int64, c_void_p
+import os
+from ctypes import POINTER, Structure, c_double, c_int32, c_int64, c_uint64, c_void_p
 from functools import lru_cache
 
 import numpy as np
@@ -27,7 +28,7 @@ LT_KIND, LT_LOC, LT_DIR, LT_INTENSITY, LT_COLUMNS = 0, 1, 4, 7, 8
 LIGHT_DIRECTIONAL, LIGHT_POINT = 1, 2
 GF_COLUMNS, GS_COLUMNS, BOX_COLUMNS = 6, 3, 7
 TRACE_SHAPE_VALUES, TRACE_LIGHT_VALUES = 22, 12
-C_TESTS, C_NAN_TESTS, C_SHADOW_RAYS = 0, 1, 2
+OUT_TESTS, OUT_NAN_TESTS, OUT_SHADOW_RAYS, OUT_HITS, OUT_LO, OUT_HI, OUT_COLUMNS = 0, 1, 2, 3, 4, 7, 10
 PC_COLUMNS = 7
 
 
@@ -37,14 +38,17 @@ class Shapes(Structure):
 
 
 class Grid(Structure):
-    _fields_ = [("faces", c_void_p), ("shape", c_void_p), ("start", c_void_p), ("entries", c_void_p),
-                ("glob", c_void_p), ("nglob", c_int64)]
+    _fields_ = [("faces", c_void_p), ("shape", c_void_p), ("start", c_void_p), ("start_count", c_int64),
+                ("entries", c_void_p), ("glob", c_void_p), ("nglob", c_int64), ("u_at", c_void_p),
+                ("v_at", c_void_p), ("n_u", c_int64), ("n_v", c_int64), ("block", c_int64), ("u_sign", c_double),
+                ("v_sign", c_double)]
 
 
 class Band(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("cam", c_void_p), ("xs", c_void_p), ("ys", c_void_p),
-                ("rotated", c_int32), ("lit", c_int32), ("width", c_int64), ("row0", c_int64), ("dirs", c_void_p),
-                ("col_cell", c_void_p), ("row_cell", c_void_p), ("pc", c_void_p), ("floor", c_void_p), ("grid", Grid), ("slot", c_void_p), ("sqd", c_void_p),
+                ("rotated", c_int32), ("lit", c_int32), ("width", c_int64), ("row0", c_int64), ("row_magic", c_uint64),
+                ("dirs", c_void_p), ("pc", c_void_p), ("floor", c_void_p), ("grid", Grid),
+                ("bucket_start", c_void_p), ("bucket_pixels", c_void_p), ("slot", c_void_p), ("sqd", c_void_p),
                 ("pt", c_void_p), ("nm", c_void_p), ("bad", c_void_p), ("nan_px", c_void_p)]
 
 
@@ -52,6 +56,17 @@ class LightPass(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("band", POINTER(Band)), ("light", c_void_p), ("scale", c_double * 3),
                 ("frame", c_double * 6), ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
                 ("along", c_void_p), ("radius", c_void_p), ("grid", Grid), ("acc", c_void_p)]
+
+
+#: Pixels a band may hold and the widest frame, for Band.row_magic (csrc/kernels.h band_row).
+BAND_LIMIT, WIDTH_LIMIT = 1 << 20, 8192
+
+
+def row_magic(width: int) -> int:
+    """Band.row_magic for a frame ``width`` pixels wide."""
+    if not 1 <= width <= WIDTH_LIMIT:
+        raise ValueError(f"frame width {width} is outside 1..{WIDTH_LIMIT}")
+    return (1 << 40) // width + 1
 
 
 def ptr(a: np.ndarray, dtype: type | np.dtype, shape: tuple[int | None, ...]) -> int:
@@ -65,8 +80,9 @@ def ptr(a: np.ndarray, dtype: type | np.dtype, shape: tuple[int | None, ...]) ->
 #: Kernel suffix per (precision, flush subnormals).
 SUFFIXES = {("fp16", True): "h16", ("fp16", False): "h16i", ("fp32", True): "f32", ("fp32", False): "f32",
             ("fp64", True): "f64", ("fp64", False): "f64"}
-_SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix
+_SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and instruction set
     "directions": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
+    "pixel_cells": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "nearest": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "origin_terms": (None, [POINTER(Shapes), c_void_p]),
     "shadow_directions": (None, [POINTER(Shapes), c_void_p, c_void_p]),
@@ -84,6 +100,8 @@ _PLAIN = {
     "bound_radii": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_int32, c_void_p]),
     "bound_floors": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double,
                             c_void_p]),
+    "bucket_sort": (None, [c_void_p, c_int64, c_int64, c_void_p, c_void_p]),
+    "have_avx2": (c_int32, []),
     "bound_primary": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_void_p]),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
 }
@@ -100,16 +118,27 @@ def library() -> ctypes.CDLL:
     table = dict(_PLAIN)
     for name, sig in _SUFFIXED.items():
         for suffix in set(SUFFIXES.values()):
-            table[f"{name}_{suffix}"] = sig
+            for isa in ("base", "avx2"):
+                table[f"{name}_{suffix}_{isa}"] = sig
     for name, (restype, argtypes) in table.items():
-        fn = getattr(lib, name)
-        fn.restype, fn.argtypes = restype, argtypes
+        fn = getattr(lib, name, None)
+        if fn is not None:  # the AVX2 build exists on x86-64 only
+            fn.restype, fn.argtypes = restype, argtypes
     return lib
+
+
+@lru_cache(maxsize=1)
+def isa() -> str:
+    """The instruction set the kernels run in: "avx2" where the processor has it, else
+    "base" (the same values either way; ``REND3R_ISA=base`` forces the baseline)."""
+    lib = library()
+    wanted = os.environ.get("REND3R_ISA", "avx2")
+    return "avx2" if wanted == "avx2" and hasattr(lib, "nearest_f32_avx2") and lib.have_avx2() else "base"
 
 
 def kernel(name: str, precision: str, ftz: bool) -> ctypes._CFuncPtr:
     """The kernel ``name`` compiled for a working precision and subnormal handling."""
-    return getattr(library(), f"{name}_{SUFFIXES[precision, ftz]}")
+    return getattr(library(), f"{name}_{SUFFIXES[precision, ftz]}_{isa()}")
 
 
 def round16(values: np.ndarray, ftz: bool) -> np.ndarray:

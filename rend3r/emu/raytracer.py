@@ -41,7 +41,7 @@ from .stats import FrameStats
 
 Progress = Callable[[float], None]
 #: Pixels per band: bounds the per-pixel working arrays (about 100 bytes per pixel).
-BAND_PIXELS = 1 << 20
+BAND_PIXELS = native.BAND_LIMIT
 #: Smallest chunk of pixels handed to a thread.
 MIN_CHUNK = 1 << 12
 _CHANNELS = ((11, 31), (5, 63), (0, 31))  # RGB565: (shift, largest value) per channel
@@ -166,7 +166,7 @@ def trace_pixel(fr: _Frame, options: EmuOptions, x: int, y: int) -> PixelTrace:
     n, nl, dtype = len(fr.sf), len(fr.lights), fr.dtype
     band = native.Band(pointer(fr.shapes), native.ptr(fr.cam, dtype, (native.CAM_COLUMNS,)),
                        native.ptr(fr.xs, dtype, (options.width,)), native.ptr(fr.ys, dtype, (options.height,)),
-                       int(fr.rotated), int(bool(fr.lights)), options.width, 0)
+                       int(fr.rotated), int(bool(fr.lights)), options.width, y, native.row_magic(options.width))
     radius = np.full(n, np.inf)
     lp = native.LightPass(pointer(fr.shapes), pointer(band), None, (0.0, 0.0, 0.0), (0.0,) * 6,
                           int(options.intensity_fixed), int(n > 1), 0, None, radius.ctypes.data, grids.EMPTY.struct())
@@ -197,23 +197,43 @@ def _chunks(n: int, jobs: int) -> list[tuple[int, int]]:
     return [(a, b) for a, b in zip(edges, edges[1:]) if b > a]
 
 
-def _run(jobs: int, n: int, fn: Callable[..., object], block: object, out: np.ndarray) -> np.ndarray:
-    """``fn(block, p0, p1, out_k)`` over chunks of 0..n on ``jobs`` threads, each chunk with
-    its own copy of ``out``; returns them stacked."""
+def _run(jobs: int, n: int, fn: Callable[..., object], block: object, last: np.ndarray | int) -> np.ndarray | None:
+    """``fn(block, k0, k1, last)`` over chunks of 0..n on ``jobs`` threads. An array ``last``
+    (e.g. counters) is copied for each chunk and the copies are returned stacked; an int
+    (an address) is passed to every chunk as it is."""
     chunks = _chunks(n, jobs)
-    outs = np.stack([out.copy() for _ in chunks])
-    ref = byref(block)
+    copies = isinstance(last, np.ndarray)
+    outs = np.stack([last.copy() for _ in chunks]) if copies else None
+    args = [(byref(block), a, b, outs[k].ctypes.data if copies else last) for k, (a, b) in enumerate(chunks)]
     if jobs == 1 or len(chunks) == 1:
-        for k, (a, b) in enumerate(chunks):
-            fn(ref, a, b, outs[k].ctypes.data)
+        for arg in args:
+            fn(*arg)
     else:
-        futures = [_pool(jobs).submit(fn, ref, a, b, outs[k].ctypes.data) for k, (a, b) in enumerate(chunks)]
-        for future in futures:
+        for future in [_pool(jobs).submit(fn, *arg) for arg in args]:
             future.result()
     return outs
 
 
-_COUNTERS = np.zeros(3, np.int64)
+#: A kernel's report per chunk (csrc/kernels.h OUT_*): counts, then the hit points' box.
+_OUT = np.zeros(native.OUT_COLUMNS)
+_OUT[native.OUT_LO:native.OUT_LO + 3], _OUT[native.OUT_HI:native.OUT_HI + 3] = np.inf, -np.inf
+
+
+def _report(outs: np.ndarray) -> np.ndarray:
+    """Chunks' reports merged: counts summed, boxes joined."""
+    out = outs.sum(axis=0)
+    out[native.OUT_LO:native.OUT_LO + 3] = outs[:, native.OUT_LO:native.OUT_LO + 3].min(axis=0)
+    out[native.OUT_HI:native.OUT_HI + 3] = outs[:, native.OUT_HI:native.OUT_HI + 3].max(axis=0)
+    return out
+
+
+def _buckets(cells: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Items by bucket (``cells``: each item's bucket, negative: none): (starts, items)."""
+    start = np.empty(count + 1, np.int64)
+    items = np.empty(len(cells), np.int32)
+    native.library().bucket_sort(native.ptr(cells, np.int32, (None,)), len(cells), count, start.ctypes.data,
+                                 items.ctypes.data)
+    return start, items
 
 
 def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, st: FrameStats,
@@ -228,64 +248,58 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, st: FrameStats,
     }
     band = native.Band(pointer(fr.shapes), native.ptr(fr.cam, dtype, (native.CAM_COLUMNS,)),
                        native.ptr(fr.xs, dtype, (w,)), native.ptr(fr.ys, dtype, (options.height,)),
-                       int(fr.rotated), int(lit), w, row0)
-    tables = _grid_camera(fr, row0, row1)
-    if tables is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
+                       int(fr.rotated), int(lit), w, row0, native.row_magic(w))
+    pixels, boxes = _pixel_grid(fr, row0, row1)
+    if pixels is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
         a["dirs"] = np.empty((n_pix, 4), dtype)
         band.dirs = a["dirs"].ctypes.data
         boxes = grids.merge_boxes(_run(fr.jobs, n_pix, fr.kernel("directions"), band, grids.EMPTY_BOXES))
-    else:
-        u, v, boxes = tables
-    grid, floor, pc = _primary_grid(fr, boxes)
-    if tables is not None:
-        a["col_cell"], a["row_cell"] = _cells(grid, u, 2), _cells(grid, v, 2, rows=True)
-        band.col_cell, band.row_cell = a["col_cell"].ctypes.data, a["row_cell"].ctypes.data
+    grid, floor, pc = _primary_grid(fr, boxes, pixels)
     band.pc, band.floor, band.grid = pc.ctypes.data, floor.ctypes.data, grid.struct()
     for name in ("slot", "sqd", "pt", "nm", "bad", "nan_px"):
         setattr(band, name, a[name].ctypes.data)
-    c = _run(fr.jobs, n_pix, fr.kernel("nearest"), band, _COUNTERS).sum(axis=0)
-    st.tests += int(c[native.C_TESTS])
-    st.nan_tests += int(c[native.C_NAN_TESTS])
-    st.skipped += n_pix * n - int(c[native.C_TESTS])
+    packets = grid.cells
+    if pixels is None:  # pixels by cell, the last bucket for rays outside the grid
+        a["cells"] = np.empty(n_pix, np.int32)
+        _run(fr.jobs, n_pix, fr.kernel("pixel_cells"), band, a["cells"].ctypes.data)
+        a["start"], a["pixels"] = _buckets(a["cells"], grid.cells + 1)
+        band.bucket_start, band.bucket_pixels = a["start"].ctypes.data, a["pixels"].ctypes.data
+        packets += 1
+    c = _report(_run(fr.jobs, packets, fr.kernel("nearest"), band, _OUT))
+    st.tests += int(c[native.OUT_TESTS])
+    st.nan_tests += int(c[native.OUT_NAN_TESTS])
+    st.skipped += n_pix * n - int(c[native.OUT_TESTS])
     acc = np.zeros((n_pix if lit else 0, 3))
     for k in range(len(fr.lights)):
-        _light(fr, options, k, band, a, acc, st)
+        _light(fr, options, k, band, c, acc, st)
     st.hits += fr.kernel("finish")(byref(band), acc.ctypes.data, fr.index.ctypes.data, options.background, 0, n_pix,
                                    native.ptr(rgb, np.uint16, (n_pix,)), native.ptr(depth, np.float32, (n_pix,)),
                                    native.ptr(prov, np.int32, (n_pix,)))
     st.nan_rays += int(a["nan_px"].sum())
 
 
-def _grid_camera(fr: _Frame, row0: int, row1: int) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+def _pixel_grid(fr: _Frame, row0: int, row1: int) -> tuple[grids.PixelLayout | None, np.ndarray | None]:
     """For a camera whose directions are (x[col], y[row], z), z finite and not zero: each
-    column's u = x/z and each row's v = y/z (their lines' coordinates on face 2, shared
-    by the grid and the lookups) and the face boxes; else None."""
+    column's u = x/z and each row's v = y/z (their lines' coordinates on face 2) as a pixel
+    layout, and the face boxes; (None, None) for other cameras, or where u or v is not
+    finite and monotonic."""
     z = float(fr.cam[native.CAM_Z])
     if fr.rotated or not (z != 0 and np.isfinite(z)):
-        return None
+        return None, None
     xs, ys = fr.xs.astype(np.float64), fr.ys[row0:row1].astype(np.float64)
-    u, v = xs / z, ys / z
+    with np.errstate(all="ignore"):
+        pixels = grids.PixelLayout.of(xs / z, ys / z)
+    if pixels is None:
+        return None, None
     boxes = grids.EMPTY_BOXES.copy()
-    fu, fv = u[np.isfinite(u)], v[np.isfinite(v)]
-    if len(fu) and len(fv):
-        shortest = np.sqrt(np.min(xs[np.isfinite(u)] ** 2) + np.min(ys[np.isfinite(v)] ** 2) + z * z)
-        longest = np.sqrt(np.max(xs[np.isfinite(u)] ** 2) + np.max(ys[np.isfinite(v)] ** 2) + z * z)
-        boxes[2] = (fu.min(), fu.max(), fv.min(), fv.max(), len(fu) * len(fv), shortest, longest)
-    return u, v, boxes
+    shortest = np.sqrt(np.min(xs**2) + np.min(ys**2) + z * z)
+    longest = np.sqrt(np.max(xs**2) + np.max(ys**2) + z * z)
+    boxes[2] = (pixels.u.min(), pixels.u.max(), pixels.v.min(), pixels.v.max(), len(xs) * len(ys), shortest, longest)
+    return pixels, boxes
 
 
-def _cells(grid: grids.Grid, coords: np.ndarray, face: int, rows: bool = False) -> np.ndarray:
-    """Per column (u) or row (v) of a grid camera, its part of the cell index on ``face``,
-    as the kernels' cell_of computes it; -1 outside the grid."""
-    nu, nv, first = (int(c) for c in grid.shape[face])
-    lo, hi, scale = (grid.faces[face, k] for k in ((2, 3, 5) if rows else (0, 1, 4)))
-    count = nv if rows else nu
-    inside = (lo <= coords) & (coords <= hi) & (count > 0)
-    index = np.minimum(((np.where(inside, coords, lo) - lo) * scale).astype(np.int64), count - 1)
-    return np.where(inside, first + index * nu if rows else index, -1).astype(np.int64)
-
-
-def _primary_grid(fr: _Frame, boxes: np.ndarray) -> tuple[grids.Grid, np.ndarray, np.ndarray]:
+def _primary_grid(fr: _Frame, boxes: np.ndarray,
+                  pixels: grids.PixelLayout | None) -> tuple[grids.Grid, np.ndarray, np.ndarray]:
     """The primary rays' grid, and per shape its depth floor and cull data."""
     used = boxes[:, 4] > 0
     dmin = float(boxes[used, 5].min()) if used.any() else 0.0
@@ -302,7 +316,7 @@ def _primary_grid(fr: _Frame, boxes: np.ndarray) -> tuple[grids.Grid, np.ndarray
     native.library().bound_primary(fr.bnd.ctypes.data, radius.ctypes.data, len(radius), apex.ctypes.data, dmin, u,
                                    tiny, pc.ctypes.data)
     order = np.argsort(floor, kind="stable").astype(np.int32)
-    return grids.build(boxes, False, centers, radius, order), floor, pc
+    return grids.build(boxes, False, centers, radius, order, pixels), floor, pc
 
 
 #: shadow_origins' output: bounding box of the points, largest magnitude, largest chord,
@@ -310,69 +324,89 @@ def _primary_grid(fr: _Frame, boxes: np.ndarray) -> tuple[grids.Grid, np.ndarray
 _ORIGINS = np.concatenate([[np.inf] * 3 + [-np.inf] * 3 + [0.0, 0.0], grids.EMPTY_BOXES.ravel()])
 
 
-def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, a: dict[str, np.ndarray], acc: np.ndarray,
+def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.ndarray, acc: np.ndarray,
            st: FrameStats) -> None:
-    """Add light ``k`` to the band's colour sums, with its shadow rays."""
+    """Add light ``k`` to the band's colour sums, with its shadow rays (``hits``: the
+    nearest-hit pass's report, with the box of the band's hit points)."""
     light = fr.light_rows[k]
     colour = fr.lights[k].color
-    n_pix, n = len(a["slot"]), len(fr.sf)
+    n_pix, n = len(acc), len(fr.sf)
     shadows = n > 1
     point = light[native.LT_KIND] == native.LIGHT_POINT
     lp = native.LightPass(pointer(fr.shapes), pointer(band), native.ptr(light, fr.dtype, (native.LT_COLUMNS,)),
                           (*[((colour >> shift) & top) / top for shift, top in _CHANNELS],))
     lp.fixed, lp.shadows, lp.parallel, lp.acc = int(options.intensity_fixed), int(shadows), int(not point), acc.ctypes.data
     if shadows:  # the block points into grid, radius and along: they live until the pass is done
-        grid, radius, along = _shadow_grid(fr, lp, light, n_pix)
+        grid, radius, along = _shadow_grid(fr, lp, light, hits, n_pix)
         lp.grid, lp.radius, lp.along = grid.struct(), radius.ctypes.data, along.ctypes.data
-    c = _run(fr.jobs, n_pix, fr.kernel("light_pass"), lp, _COUNTERS).sum(axis=0)
-    st.shadow_rays += int(c[native.C_SHADOW_RAYS])
-    st.tests += int(c[native.C_TESTS])
-    st.nan_tests += int(c[native.C_NAN_TESTS])
+    c = _report(_run(fr.jobs, n_pix, fr.kernel("light_pass"), lp, _OUT))
+    st.shadow_rays += int(c[native.OUT_SHADOW_RAYS])
+    st.tests += int(c[native.OUT_TESTS])
+    st.nan_tests += int(c[native.OUT_NAN_TESTS])
     if shadows:
-        st.skipped += int(c[native.C_SHADOW_RAYS]) * (n - 1) - int(c[native.C_TESTS])
+        st.skipped += int(c[native.OUT_SHADOW_RAYS]) * (n - 1) - int(c[native.OUT_TESTS])
 
 
-def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray,
+#: shadow_origins' output: bounding box of the points, largest magnitude, largest chord,
+#: then the face boxes.
+_ORIGINS = np.concatenate([[np.inf] * 3 + [-np.inf] * 3 + [0.0, 0.0], grids.EMPTY_BOXES.ravel()])
+
+
+def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.ndarray,
                  n_pix: int) -> tuple[grids.Grid, np.ndarray, np.ndarray]:
     """The grid of a light's shadow rays from the band's hit points (``lp`` gets its
     frame): (grid, cull radii, per-shape terms along a directional light's l)."""
     n = len(fr.sf)
     centers = fr.bnd[:, :3]
     along = np.zeros((0, 4), fr.dtype)
-    point = not lp.parallel
-    if point:
-        apex = light[native.LT_LOC:native.LT_LOC + 3].astype(np.float64)
-        lp.frame[:3] = apex
-    else:
-        l = light[native.LT_DIR:native.LT_DIR + 3].astype(np.float64)
-        length = float(np.sqrt(l @ l)) if np.isfinite(l).all() else 0.0
-        if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
-            return grids.EMPTY, np.full(n, np.inf), along
-        axes = _normal_plane(l / length)
-        lp.frame[:] = axes.ravel()
-    out = _run(fr.jobs, n_pix, fr.kernel("shadow_origins"), lp, _ORIGINS)
-    lo, hi = out[:, :3].min(axis=0), out[:, 3:6].max(axis=0)
-    magnitude, chord = out[:, 6].max(), out[:, 7].max()
-    boxes = grids.merge_boxes(out[:, 8:].reshape(len(out), 3, native.BOX_COLUMNS))
-    if not boxes[:, 4].any():  # no hit point: no shadow ray
-        return grids.EMPTY, np.full(n, np.inf), along
+    unbounded = grids.EMPTY, np.full(n, np.inf), along  # every ray tests every shape
+    if not hits[native.OUT_HITS]:
+        return unbounded
+    lo, hi = hits[native.OUT_LO:native.OUT_LO + 3], hits[native.OUT_HI:native.OUT_HI + 3]
+    magnitude = max(np.abs(lo).max(), np.abs(hi).max())  # of any hit point's coordinates
+    u, tiny = fr.ar.unit_roundoff, fr.ar.tiny
     with np.errstate(all="ignore"):
         mid, half = (lo + hi) / 2, np.sqrt(((hi - lo) ** 2).sum()) / 2
         far = np.sqrt(((centers - mid) ** 2).sum(axis=1)) * (1 + bounds.SLACK) + half  # to any origin, at most
-        slack = 1e-12 * (np.sqrt((centers ** 2).sum(axis=1)) + magnitude)
-    u, tiny = fr.ar.unit_roundoff, fr.ar.tiny
-    if point:
+        slack = 1e-12 * (np.sqrt((centers**2).sum(axis=1)) + magnitude)
+    if not lp.parallel:  # a point light: lines through the light, up to the rounding of l
+        apex = light[native.LT_LOC:native.LT_LOC + 3].astype(np.float64)
+        lp.frame[:3] = apex
+        origins = _report_origins(_run(fr.jobs, n_pix, fr.kernel("shadow_origins"), lp, _ORIGINS))
+        boxes, chord = origins[8:].reshape(3, native.BOX_COLUMNS), origins[7]
+        if not boxes[:, 4].any():
+            return unbounded
         bounded = fr.bounded & bool(np.isfinite(apex).all())
         radius = bounds.cull_radii(fr.bnd, bounded, far, float(boxes[:, 5].min()), u, tiny, fr.fp16)
         radius += far * (chord * (1 + bounds.SLACK) + 1e-15) + slack
         return grids.build(boxes, False, centers - apex, radius, np.arange(n, dtype=np.int32)), radius, along
+    l = light[native.LT_DIR:native.LT_DIR + 3].astype(np.float64)
+    length = float(np.sqrt((l * l).sum())) if np.isfinite(l).all() else 0.0
+    if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
+        return unbounded
+    axes = _normal_plane(l / length)
+    lp.frame[:] = axes.ravel()
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    uv = _project(corners, axes)  # the points' projections lie in the box of the corners' (widened for rounding)
+    low, high = uv.min(axis=0), uv.max(axis=0)
+    pad = 1e-9 * (np.abs(uv).max() + magnitude)
+    boxes = grids.EMPTY_BOXES.copy()
+    boxes[0, :5] = low[0] - pad, high[0] + pad, low[1] - pad, high[1] + pad, hits[native.OUT_HITS]
     radius = bounds.cull_radii(fr.bnd, fr.bounded, far, length, u, tiny, fr.fp16) + slack
     flat = np.zeros((n, 3))
     with np.errstate(all="ignore"):  # unbounded shapes (infinite centres) have an infinite radius
         flat[:, :2] = _project(centers, axes)
     along = np.empty((n, 4), fr.dtype)
     fr.kernel("shadow_directions")(byref(fr.shapes), light.ctypes.data, along.ctypes.data)
-    return grids.build(boxes, True, flat, radius, np.arange(n, dtype=np.int32)), radius, along
+    return grids.build(boxes, True, flat, radius, np.arange(n, dtype=np.int32), rays_per_cell=32), radius, along
+
+
+def _report_origins(outs: np.ndarray) -> np.ndarray:
+    """shadow_origins' chunks merged: boxes joined, the largest chord kept."""
+    out = _ORIGINS.copy()
+    out[:3], out[3:6], out[6:8] = outs[:, :3].min(axis=0), outs[:, 3:6].max(axis=0), outs[:, 6:8].max(axis=0)
+    out[8:] = grids.merge_boxes(outs[:, 8:].reshape(len(outs), 3, native.BOX_COLUMNS)).ravel()
+    return out
 
 
 def _project(points: np.ndarray, axes: np.ndarray) -> np.ndarray:

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import click
 
-from ..cliutil import SIZE
+from ..cliutil import JOBS, SIZE
 from ..errors import Rend3rError
 from .catalog import ExampleProgram, program_paths, read_header
 
@@ -80,7 +80,9 @@ def render_all(
 @click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormal handling.")
 @click.option("--size", type=SIZE, default="512x384", show_default=True, help="Image size (1..8192 each).")
-def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnormals: str, size: tuple[int, int]) -> None:
+@JOBS
+def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnormals: str, size: tuple[int, int],
+                       jobs: int) -> None:
     """Render every PROGRAMS_DIR/*.asm (default: programs) to PNGs in OUT.
 
     Each program's header sets its frame count (``; frames: N``) and mode. Files are
@@ -97,7 +99,7 @@ def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnor
     if not programs_dir.is_dir():
         raise Rend3rError(f"{programs_dir} is not a folder")
     width, height = size
-    options = EmuOptions(precision=precision, subnormals=subnormals, width=width, height=height)
+    options = EmuOptions(precision=precision, subnormals=subnormals, width=width, height=height, jobs=jobs)
     failed = render_all(programs_dir, out_dir, options, echo=click.echo)
     if failed:
         raise Rend3rError(f"{len(failed)} program(s) failed: {', '.join(failed)}")

@@ -31,13 +31,15 @@ def _scene(prog: Prog):
 
 
 def _rays(ar, center, origin, radius, rng, count=4000):
-    """Directions (working precision) aimed at and around a centre from an origin."""
+    """Directions (working precision) aimed at and around a centre from an origin, of
+    lengths from a hundredth to four times the distance (short ones are where underflow
+    enters the bounds)."""
     aim = (center - origin) + rng.normal(size=(count, 3)) * radius * rng.uniform(0.2, 1.5)
-    aim *= rng.uniform(0.5, 4.0, size=(count, 1))
+    aim *= 10.0 ** rng.uniform(-2.0, 0.6, size=(count, 1))
     return tuple(ar.round(aim[:, k].astype(ar.dtype)) for k in range(3))
 
 
-@settings(max_examples=60)
+@settings(max_examples=120)
 @given(st.sampled_from(ARITHS), st.tuples(coord, coord, st.floats(-12, -2, allow_nan=False, width=16)),
        st.floats(0.25, 4.0, width=16), st.floats(0.75, 1.25, width=16),
        st.tuples(*[st.floats(-1, 1, allow_nan=False, width=16)] * 4), st.tuples(coord, coord), st.integers(0, 2**31))
@@ -101,7 +103,7 @@ def test_deep_scenes_render_as_the_reference_with_few_tests(precision, subnormal
     assert stats.tests < stats.skipped / 10
 
 
-@pytest.mark.parametrize("precision,per_pixel", [("fp16", 3), ("fp32", 1.1), ("fp64", 1.1)])
+@pytest.mark.parametrize("precision,per_pixel", [("fp16", 3), ("fp32", 1.2), ("fp64", 1.2)])
 def test_shapes_behind_the_nearest_hit_are_not_tested(precision, per_pixel):
     """A column of 40 spheres straight ahead: a pixel stops after the first ones (the
     float16 depth floor is looser)."""

@@ -17,6 +17,12 @@
 #include "kernels.h"
 
 #define BOUND_SLACK 1e-9
+/* The largest effective unit roundoff (u plus an underflow's absolute error over the
+ * squared direction length in normal space, tiny / min(1, |D|^2)) the bounds are claimed
+ * for: 2**-6, where the first-order error terms they sum still dominate. For float16
+ * this asks |D| >= 2**-4, as before; fp32 and fp64 allow any direction that is not
+ * near their own underflow. */
+#define MAX_UU 0.015625
 /* A finite float16 a2*c2 is below 65520; with the coefficients' rounding error allowed
  * for, |D|^2 (|S|^2 - 1) stays below 16380 * 1.02 / (1 - 2**-6)**2. */
 #define F16_PRODUCT_LIMIT (16380.0 * 1.02 / ((1.0 - 0.015625) * (1.0 - 0.015625)))
@@ -27,9 +33,9 @@ static inline double cull_radius(double smin, double smax, double dist, double d
                                  int fp16)
 {
     double dhat = smin * dmin;  /* |D| in normal space, at least */
-    if (!(dhat >= 0.0625))
-        return INFINITY;
     double uu = u + tiny / fmin(1.0, dhat * dhat);
+    if (!(uu <= MAX_UU))
+        return INFINITY;
     double mm = smax * dist;
     if (fp16) {
         double cap = sqrt(1.0 + F16_PRODUCT_LIMIT / (dhat * dhat));
@@ -91,9 +97,9 @@ static inline double depth_floor(double smin, double smax, double dist, double d
                                  double tiny)
 {
     double dlo = smin * dmin;
-    if (!(dlo >= 0.0625))
-        return 0.0;
     double uu = u + tiny / fmin(1.0, fmin(dlo * dlo, dmin * dmin));
+    if (!(uu <= MAX_UU))
+        return 0.0;
     double e = 32.0 * uu * (1.0 + smax / smin);  /* transform error, relative */
     if (!(e < 0.25))
         return 0.0;

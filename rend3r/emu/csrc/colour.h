@@ -9,13 +9,13 @@
 
 static const int rgb_shift[3] = {11, 5, 0}, rgb_top[3] = {31, 63, 31};
 
-/* Colour sums rounded half up, clamped to each RGB565 channel and packed. */
+/* Colour sums rounded half up (floor(x + 0.5)), clamped to each RGB565 channel, packed. */
 static inline int64_t pack_rgb(const double *acc)
 {
     int64_t value = 0;
     for (int c = 0; c < 3; c++) {
-        double x = floor(acc[c] + 0.5);
-        value |= (int64_t)(x < 0 ? 0 : x > rgb_top[c] ? rgb_top[c] : x) << rgb_shift[c];
+        double x = acc[c] + 0.5;  /* below 1: 0; from top + 1 on: top; between: truncation is floor */
+        value |= (int64_t)(!(x >= 1.0) ? 0 : x >= rgb_top[c] + 1 ? rgb_top[c] : (int)x) << rgb_shift[c];
     }
     return value;
 }

@@ -17,42 +17,23 @@
 #include "fround.h"
 #include "grids.h"
 #include "kernels.h"
+#include "simd.h"
+#include "cull.h"
 
-/* fp32: float operations round to float themselves. */
-#define W float
-#define FN(name) name##_f32
-#define R(x) (x)
-#define SQRTW sqrtf
-#include "datapath.inc"
-#undef FN
-#undef R
+#define ISA base
+#include "instances.inc"
+#undef ISA
 
-/* fp16, subnormals flushed (the device's floating-point IP). */
-#define FN(name) name##_h16
-#define R(x) round16((x), 1)
-#include "datapath.inc"
-#undef FN
-#undef R
-
-/* fp16, IEEE gradual underflow. */
-#define FN(name) name##_h16i
-#define R(x) round16((x), 0)
-#include "datapath.inc"
-#undef W
-#undef FN
-#undef R
-#undef SQRTW
-
-/* fp64. */
-#define W double
-#define FN(name) name##_f64
-#define R(x) (x)
-#define SQRTW sqrt
-#include "datapath.inc"
-#undef W
-#undef FN
-#undef R
-#undef SQRTW
+/* Whether this processor runs the AVX2 build of the kernels (kernels_avx2.c). */
+int32_t have_avx2(void)
+{
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0;
+#else
+    return 0;
+#endif
+}
 
 /* ---- grids (rend3r/emu/grids.py) ---- */
 
@@ -69,6 +50,33 @@ static void ratio_range(double x, double z, double r, double *lo, double *hi)
             *lo = fmin(*lo, q);
             *hi = fmax(*hi, q);
         }
+}
+
+/* The first index of ascending a[0..n) whose value is >= x (after = 0) or > x (after = 1). */
+static int64_t search(const double *a, int64_t n, double x, int after)
+{
+    int64_t lo = 0, hi = n;
+    while (lo < hi) {
+        int64_t mid = lo + (hi - lo) / 2;
+        if (after ? a[mid] <= x : a[mid] < x)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* The cells of a pixel grid whose rays' (u, v) lie in [ulo, uhi] x [vlo, vhi]. */
+static int pixel_footprint(const Grid *g, double ulo, double uhi, double vlo, double vhi, int64_t *out)
+{
+    double a0 = g->u_sign > 0 ? ulo : -uhi, a1 = g->u_sign > 0 ? uhi : -ulo;
+    double b0 = g->v_sign > 0 ? vlo : -vhi, b1 = g->v_sign > 0 ? vhi : -vlo;
+    int64_t c0 = search(g->u_at, g->n_u, a0, 0), c1 = search(g->u_at, g->n_u, a1, 1) - 1;
+    int64_t r0 = search(g->v_at, g->n_v, b0, 0), r1 = search(g->v_at, g->n_v, b1, 1) - 1;
+    if (c0 > c1 || r0 > r1)
+        return 0;
+    out[0] = c0 / g->block; out[1] = c1 / g->block; out[2] = r0; out[3] = r1;
+    return 1;
 }
 
 /* The cell rectangle a ball (centre c relative to the apex, or projected (u, v) for a
@@ -94,6 +102,8 @@ static int footprint(const Grid *g, int parallel, int face, const double *c, dou
     }
     ulo -= UV_SLACK * (1.0 + fabs(ulo)); vlo -= UV_SLACK * (1.0 + fabs(vlo));
     uhi += UV_SLACK * (1.0 + fabs(uhi)); vhi += UV_SLACK * (1.0 + fabs(vhi));
+    if (face == 2 && g->u_at != NULL)
+        return pixel_footprint(g, ulo, uhi, vlo, vhi, out);
     if (!(ulo <= f[GF_U1] && uhi >= f[GF_U0] && vlo <= f[GF_V1] && vhi >= f[GF_V0]))
         return 0;
     out[0] = (int64_t)((fmax(ulo, f[GF_U0]) - f[GF_U0]) * f[GF_SU]);
@@ -184,6 +194,25 @@ void bound_primary(const double *bnd, const double *radius, int64_t n, const dou
         pc[PC_BEHIND] = r < INFINITY && dist > r ? ((smax * smax - smin * smin) / 2.0 + 64.0 * uu * smax * smax) * dist
                                                  : NAN;
     }
+}
+
+/* Counting sort: the items (0..n) by their bucket (0..nbuckets; negative: left out), in
+ * order within a bucket. start gets nbuckets + 1 entries. */
+void bucket_sort(const int32_t *bucket, int64_t n, int64_t nbuckets, int64_t *start, int32_t *items)
+{
+    for (int64_t k = 0; k <= nbuckets; k++)
+        start[k] = 0;
+    for (int64_t i = 0; i < n; i++)
+        if (bucket[i] >= 0)
+            start[bucket[i] + 1]++;
+    for (int64_t k = 0; k < nbuckets; k++)
+        start[k + 1] += start[k];
+    for (int64_t i = 0; i < n; i++)
+        if (bucket[i] >= 0)
+            items[start[bucket[i]]++] = (int32_t)i;
+    for (int64_t k = nbuckets; k > 0; k--)
+        start[k] = start[k - 1];
+    start[0] = 0;
 }
 
 /* ---- rounding, for tests ---- */

@@ -9,6 +9,10 @@
 
 #include <stdint.h>
 
+/* Minimum and maximum of numbers known not to be NaN (fmin and fmax are library calls). */
+#define MIN(a, b) ((a) < (b) ? (a) : (b))
+#define MAX(a, b) ((a) > (b) ? (a) : (b))
+
 /* Shape float table columns (working type): location, quaternion (r, i, j, k), inverse
  * scales, normal form (z sign, constant), the camera origin in normal space and its
  * origin term. Int table columns: rotation exactly (1, +0, +0, +0), RGB565 colour. */
@@ -32,8 +36,9 @@ enum { BOX_COLUMNS = 7 };
 enum { PC_V = 0, PC_VV = 3, PC_R2 = 4, PC_MEAN2 = 5, PC_BEHIND = 6, PC_COLUMNS = 7 };
 /* Values per shape and per light in a pixel trace. */
 enum { TRACE_SHAPE_VALUES = 22, TRACE_LIGHT_VALUES = 12 };
-/* Counters: tests, tests that met NaN or infinity, shadow rays. */
-enum { C_TESTS = 0, C_NAN_TESTS = 1, C_SHADOW_RAYS = 2 };
+/* What a kernel reports per chunk (double): tests, tests that met NaN or infinity, shadow
+ * rays, hit pixels with a finite hit point and those points' bounding box. */
+enum { OUT_TESTS = 0, OUT_NAN_TESTS = 1, OUT_SHADOW_RAYS = 2, OUT_HITS = 3, OUT_LO = 4, OUT_HI = 7, OUT_COLUMNS = 10 };
 
 typedef struct {
     void *sf;               /* n x SF_COLUMNS, working */
@@ -47,9 +52,16 @@ typedef struct {
     const double *faces;    /* 3 x GF_COLUMNS */
     const int64_t *shape;   /* 3 x GS_COLUMNS */
     const int64_t *start;   /* cells + 1 */
+    int64_t start_count;    /* cells + 1 */
     const int32_t *entries; /* shape slots, per cell */
     const int32_t *glob;    /* shape slots every ray tests */
     int64_t nglob;
+    /* A grid camera's pixel grid (face 2 only; u_at NULL otherwise): cells are runs of
+     * `block` columns of one row; u_at holds u_sign * u of every column and v_at v_sign * v
+     * of every row of the band, both ascending. */
+    const double *u_at, *v_at;
+    int64_t n_u, n_v, block;
+    double u_sign, v_sign;
 } Grid;
 
 typedef struct {            /* the primary rays of one band of rows */
@@ -59,12 +71,13 @@ typedef struct {            /* the primary rays of one band of rows */
     int32_t rotated;        /* turn (x, y, z) by the camera's rotation */
     int32_t lit;            /* keep hit points and normals */
     int64_t width, row0;
-    void *dirs;             /* pixels x 4: direction and |d|^2, working (rotated camera) */
-    const int64_t *col_cell;/* grid camera: per column its cell's u part, per row (of the band) */
-    const int64_t *row_cell;/* its v part; -1 outside the grid. NULL: a rotated camera */
+    uint64_t row_magic;     /* floor(2**40 / width) + 1: band_row without a division */
+    void *dirs;             /* pixels x 4: direction and |d|^2, working (rotated camera; else NULL) */
     const double *pc;       /* per shape PC_COLUMNS: the primary rays' cull data (bounds.h) */
     const double *floor;    /* depth floor per shape */
     Grid grid;
+    const int64_t *bucket_start; /* rotated camera: pixels by cell, cells + 2 starts (last: outside) */
+    const int32_t *bucket_pixels;
     int32_t *slot;          /* nearest shape, -1 none */
     void *sqd;              /* its sq_dist, working */
     void *pt, *nm;          /* pixels x 3, working (lit only) */
@@ -86,5 +99,13 @@ typedef struct {            /* one light over one band */
     Grid grid;
     double *acc;            /* pixels x 3 colour sums */
 } LightPass;
+
+/* The row within its band of pixel p: (p * row_magic) >> 40 equals p / width exactly for
+ * p < 2**20 and width <= 8192 (the error p * (row_magic - 2**40/width) / 2**40 < 2**-20
+ * stays below the 1/width a fraction p/width keeps from the next integer). */
+static inline int64_t band_row(const Band *b, int64_t p)
+{
+    return (int64_t)(((uint64_t)p * b->row_magic) >> 40);
+}
 
 #endif

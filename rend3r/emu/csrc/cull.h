@@ -1,0 +1,53 @@
+/* The cull tests of bounds.h for four rays at once (double lanes).
+ *
+ * primary_cull4: rays from the camera, against one shape's primary cull data (pc, see
+ *   bound_primary): off the line, or behind the camera.
+ * misses4: rays with their own origins (shadow rays), against one shape's centre and cull
+ *   radius: off the line, or the shape behind the origin.
+ * A set lane means "provably no hit"; NaN anywhere leaves the lane clear.
+ */
+#ifndef REND3R_CULL_H
+#define REND3R_CULL_H
+
+#include <math.h>
+
+#include "bounds.h"
+#include "kernels.h"
+#include "simd.h"
+
+INLINE f64x4 sqrt4(f64x4 x)
+{
+    f64x4 r;
+    for (int i = 0; i < 4; i++)
+        r[i] = sqrt(x[i]);
+    return r;
+}
+
+/* |v|^2 - (v.d)^2/|d|^2 > r^2 is tested times |d|^2, which needs no division. */
+INLINE i64x4 primary_cull4(const double *pc, f64x4 d0, f64x4 d1, f64x4 d2, f64x4 dd, f64x4 len)
+{
+    f64x4 vd = pc[PC_V] * d0 + pc[PC_V + 1] * d1 + pc[PC_V + 2] * d2;
+    i64x4 off = pc[PC_VV] * dd - vd * vd > pc[PC_R2] * dd;
+    return off | (-pc[PC_MEAN2] * vd - len * pc[PC_BEHIND] > 0.015625);
+}
+
+INLINE i64x4 misses4(const double *b, double r, f64x4 o0, f64x4 o1, f64x4 o2, f64x4 d0, f64x4 d1, f64x4 d2,
+                            double u, double tiny)
+{
+    i64x4 none = {0, 0, 0, 0};
+    if (!(r < INFINITY))
+        return none;
+    f64x4 v0 = b[B_CENTER] - o0, v1 = b[B_CENTER + 1] - o1, v2 = b[B_CENTER + 2] - o2;
+    f64x4 vv = v0 * v0 + v1 * v1 + v2 * v2, vd = v0 * d0 + v1 * d1 + v2 * d2, dd = d0 * d0 + d1 * d1 + d2 * d2;
+    i64x4 off = vv * dd - vd * vd > (r * r * (1.0 + BOUND_SLACK) + 1e-12 * vv) * dd;
+    double smin = b[B_SMIN], smax = b[B_SMAX];
+    f64x4 dist = sqrt4(vv), dlen = sqrt4(dd), m = smin * smin * dd;
+    const f64x4 one = {1.0, 1.0, 1.0, 1.0};
+    m = (f64x4)SEL_BITS((u64x4)(m < 1.0), (u64x4)m, (u64x4)one);
+    f64x4 uu = u + tiny / m;
+    f64x4 k = ((smax * smax - smin * smin) / 2.0 + 64.0 * uu * smax * smax) * dist;
+    i64x4 behind = (dist > r) & (-((smax * smax + smin * smin) / 2.0) * vd - dlen * k > 0.015625);
+    return off | behind;
+}
+
+#endif

@@ -3,8 +3,9 @@
 When a ray provably cannot hit a shape, or cannot hit it nearer than some distance, *as
 the working-precision raycaster computes it* (not merely in exact arithmetic); derived in
 ``docs/emulator.md`` section 7. Only spheres with moderate maps (|q|^2 min|s_i| >= 2^-6,
-|q|^2 max|s_i| <= 2^6, finite centre) are bounded; every other shape gets an infinite
-cull radius and a zero depth floor, so every ray tests it.
+|q|^2 max|s_i| <= 2^6, finite centre) are bounded (the shape tables mark them, see
+``csrc/datapath.inc`` shape_tables); every other shape gets an infinite cull radius and a
+zero depth floor, so every ray tests it.
 """
 
 from __future__ import annotations
@@ -14,24 +15,6 @@ import numpy as np
 from . import native
 
 SLACK = 1e-9
-
-
-def shape_bounds(loc: np.ndarray, rot: np.ndarray, inv: np.ndarray, sphere: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The bound table (n, B_COLUMNS) float64 of shapes with locations (n, 3), quaternions
-    (n, 4) and inverse scales (n, 3), and which of them are bounded at all.
-
-    The world-to-normal-space map is |q|^2 diag(s) R^T: its singular values are |q|^2 |s_i|.
-    """
-    with np.errstate(all="ignore"):  # inf * 0 in degenerate shapes: not bounded below
-        q2 = (rot.astype(np.float64) ** 2).sum(axis=1)
-        s = np.abs(inv.astype(np.float64))
-        table = np.empty((len(loc), native.B_COLUMNS))
-        table[:, native.B_CENTER:native.B_CENTER + 3] = loc
-        table[:, native.B_SMIN] = q2 * s.min(axis=1, initial=np.inf)
-        table[:, native.B_SMAX] = q2 * s.max(axis=1, initial=0.0)
-        ok = (sphere & np.isfinite(table[:, :3]).all(axis=1) & (table[:, native.B_SMIN] >= 2.0**-6)
-              & (table[:, native.B_SMAX] <= 2.0**6))
-    return table, ok
 
 
 def cull_radii(table: np.ndarray, ok: np.ndarray, dist: np.ndarray, dmin: float, u: float, tiny: float,

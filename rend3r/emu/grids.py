@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from ctypes import byref
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -38,19 +38,23 @@ RAYS_PER_CELL = 8
 #: Entries the cell lists may hold: this many per cell, within [MIN_BUDGET, MAX_BUDGET].
 ENTRIES_PER_CELL, MIN_BUDGET, MAX_BUDGET = 32, 1 << 22, 1 << 26
 MAX_CELLS_PER_AXIS = 4096
+#: A pixel grid's lists hold at most this many entries per pixel, else its blocks grow (up
+#: to MAX_BLOCK columns x rows): deep scenes list every shape behind a pixel.
+PIXEL_ENTRIES, MAX_BLOCK = 2, (64, 16)
 #: Per face: u0, u1, v0, v1, rays, shortest and longest direction (as the kernels fill it).
 EMPTY_BOXES = np.tile(np.array([np.inf, -np.inf, np.inf, -np.inf, 0.0, np.inf, -np.inf]), (3, 1))
 
 
 @dataclass(frozen=True)
 class PixelLayout:
-    """Cells of a grid camera: runs of ``block`` columns of one row. ``u`` holds each
-    column's u = x/z and ``v`` each row's v = y/z (both monotonic), as the rays' lines have
-    them on face 2."""
+    """Cells of a grid camera: blocks of ``block`` columns by ``block_rows`` rows. ``u``
+    holds each column's u = x/z and ``v`` each row's v = y/z (both monotonic), as the rays'
+    lines have them on face 2."""
 
     u: np.ndarray
     v: np.ndarray
     block: int = 8
+    block_rows: int = 1
 
     @classmethod
     def of(cls, u: np.ndarray, v: np.ndarray) -> "PixelLayout | None":
@@ -59,6 +63,16 @@ class PixelLayout:
             if not (np.isfinite(a).all() and ((np.diff(a) >= 0).all() or (np.diff(a) <= 0).all())):
                 return None
         return cls(u, v)
+
+    @property
+    def pixels(self) -> int:
+        return len(self.u) * len(self.v)
+
+    def coarser(self) -> "PixelLayout":
+        """Blocks twice as large: wider first, then taller, up to MAX_BLOCK."""
+        if self.block <= self.block_rows * 4 and self.block < MAX_BLOCK[0]:
+            return replace(self, block=self.block * 2)
+        return replace(self, block_rows=min(self.block_rows * 2, MAX_BLOCK[1]))
 
     @staticmethod
     def oriented(a: np.ndarray) -> tuple[np.ndarray, float]:
@@ -77,7 +91,7 @@ class Grid:
     start: np.ndarray  # (cells + 1,) int64
     entries: np.ndarray  # int32 shape positions
     glob: np.ndarray  # int32 shape positions every ray tests
-    layout: tuple[np.ndarray, float, np.ndarray, float, int] | None = None  # u_at, u_sign, v_at, v_sign, block
+    layout: tuple | None = None  # a pixel grid's (u_at, u_sign, v_at, v_sign, block, block_rows)
 
     def struct(self) -> native.Grid:
         """The kernels' view (the arrays must outlive it)."""
@@ -87,7 +101,7 @@ class Grid:
             len(self.start), native.ptr(self.entries, np.int32, (None,)), native.ptr(self.glob, np.int32, (None,)),
             len(self.glob))
         if self.layout is not None:
-            u_at, view.u_sign, v_at, view.v_sign, view.block = self.layout
+            u_at, view.u_sign, v_at, view.v_sign, view.block, view.block_rows = self.layout
             view.u_at, view.v_at = native.ptr(u_at, np.float64, (None,)), native.ptr(v_at, np.float64, (None,))
             view.n_u, view.n_v = len(u_at), len(v_at)
         return view
@@ -137,10 +151,19 @@ def _pixel_faces(pixels: PixelLayout) -> tuple[np.ndarray, np.ndarray, tuple]:
     faces = np.zeros((3, native.GF_COLUMNS))
     shape = np.zeros((3, native.GS_COLUMNS), np.int64)
     faces[2, :4] = pixels.u.min(), pixels.u.max(), pixels.v.min(), pixels.v.max()
-    shape[2] = (-(-len(pixels.u) // pixels.block), len(pixels.v), 0)
+    shape[2] = (-(-len(pixels.u) // pixels.block), -(-len(pixels.v) // pixels.block_rows), 0)
     u_at, u_sign = PixelLayout.oriented(pixels.u)
     v_at, v_sign = PixelLayout.oriented(pixels.v)
-    return faces, shape, (u_at, u_sign, v_at, v_sign, pixels.block)
+    return faces, shape, (u_at, u_sign, v_at, v_sign, pixels.block, pixels.block_rows)
+
+
+def _sizes(rects: np.ndarray) -> np.ndarray:
+    """Per shape, the cells of its rectangles (n x 3 x 4); -1 for a shape without a radius."""
+    w = np.maximum(rects[:, :, 1] - rects[:, :, 0] + 1, 0)
+    h = np.maximum(rects[:, :, 3] - rects[:, :, 2] + 1, 0)
+    sizes = (w * h).sum(axis=1)
+    sizes[rects[:, 0, 0] < 0] = -1
+    return sizes
 
 
 def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndarray, order: np.ndarray,
@@ -148,8 +171,9 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
     """A grid over the rays' per-face ``boxes`` ((3, BOX_COLUMNS): u0, u1, v0, v1, rays, ...;
     no rays: an unused face) listing shapes: ``centers`` (n, 3) relative to the apex, or
     projected (u, v, 0) for a parallel bundle, cull ``radii``, listed in ``order``. With
-    ``pixels`` (a grid camera), the cells are its runs of pixels; else about
-    ``rays_per_cell`` rays share a cell."""
+    ``pixels`` (a grid camera), the cells are blocks of its pixels; else about
+    ``rays_per_cell`` rays share a cell. The lists may hold a few entries per ray: coarser
+    cells when they would hold more, then the largest footprints go to the global list."""
     n = len(radii)
     centers = np.ascontiguousarray(centers, np.float64)
     radii = np.ascontiguousarray(radii, np.float64)
@@ -157,31 +181,51 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
     if len(order) != n or (n and not (0 <= order.min() and order.max() < n)) or centers.shape != (n, 3):
         raise ValueError("grid: order must be a permutation of the shapes, centers (n, 3)")
     lib = native.library()
-    cells = max(1.0, float(boxes[:, 4].sum()) / rays_per_cell)
-    sizes = np.empty(n, np.int64)
-    while True:
-        faces, shape, layout = _pixel_faces(pixels) if pixels is not None else (*_layout(boxes, cells), None)
-        n_cells = int((shape[:, 0] * shape[:, 1]).sum())
-        grid = Grid(faces, shape, np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0, np.int32), layout)
-        view = grid.struct()
-        lib.grid_sizes(byref(view), int(parallel), centers.ctypes.data, radii.ctypes.data, n, sizes.ctypes.data)
-        budget = min(MAX_BUDGET, max(MIN_BUDGET, ENTRIES_PER_CELL * n_cells))
-        listed = sizes >= 0
-        total = int(sizes[listed].sum())
-        if total <= budget or cells <= 1.0 or pixels is not None:
-            break
-        cells /= 4.0  # coarser cells: footprints shrink about as much
+    rects = np.empty((n, 3, 4), np.int64)
+    if pixels is not None:  # pixel rectangles once; blocks by integer division
+        one = replace(pixels, block=1, block_rows=1)
+        faces, shape, layout = _pixel_faces(one)
+        lib.grid_footprints(byref(Grid(faces, shape, np.zeros(1, np.int64), np.zeros(0, np.int32),
+                                       np.zeros(0, np.int32), layout).struct()), 0, centers.ctypes.data,
+                            radii.ctypes.data, n, rects.ctypes.data)
+        px, none = rects[:, 2].copy(), rects[:, 2, 0] > rects[:, 2, 1]
+        while True:
+            rects[:, 2] = px // [pixels.block, pixels.block, pixels.block_rows, pixels.block_rows]
+            rects[none, 2] = (1, 0, 0, 0)
+            sizes = _sizes(rects)
+            total = int(sizes[sizes >= 0].sum())
+            if total <= PIXEL_ENTRIES * pixels.pixels or (pixels.block, pixels.block_rows) == MAX_BLOCK:
+                break
+            pixels = pixels.coarser()
+        faces, shape, layout = _pixel_faces(pixels)
+        budget = MAX_BUDGET
+    else:
+        cells = max(1.0, float(boxes[:, 4].sum()) / rays_per_cell)
+        while True:
+            faces, shape = _layout(boxes, cells)
+            lib.grid_footprints(byref(Grid(faces, shape, np.zeros(1, np.int64), np.zeros(0, np.int32),
+                                           np.zeros(0, np.int32)).struct()), int(parallel), centers.ctypes.data,
+                                radii.ctypes.data, n, rects.ctypes.data)
+            sizes = _sizes(rects)
+            total = int(sizes[sizes >= 0].sum())
+            budget = min(MAX_BUDGET, max(MIN_BUDGET, ENTRIES_PER_CELL * int((shape[:, 0] * shape[:, 1]).sum())))
+            if total <= budget or cells <= 1.0:
+                break
+            cells /= 4.0  # coarser cells: footprints shrink about as much
+        layout = None
+    listed = sizes >= 0
     if total > budget:  # the largest footprints go to the global list
         big = np.argsort(-sizes, kind="stable")[: int(listed.sum())]
         left = total - np.cumsum(sizes[big])
         listed[big[: int(np.searchsorted(-left, -budget)) + 1]] = False
+    n_cells = int((shape[:, 0] * shape[:, 1]).sum())
     flags = listed.astype(np.uint8)
     counts = np.zeros(n_cells + 1, np.int64)
-    lib.grid_fill(byref(view), int(parallel), centers.ctypes.data, radii.ctypes.data, order.ctypes.data, n,
-                  flags.ctypes.data, counts[1:].ctypes.data, None, 0)
+    lib.grid_fill(rects.ctypes.data, shape.ctypes.data, order.ctypes.data, n, flags.ctypes.data,
+                  counts[1:].ctypes.data, None, 0)
     start = np.cumsum(counts)
     entries = np.empty(int(start[-1]), np.int32)
     pos = start[:-1].copy()
-    lib.grid_fill(byref(view), int(parallel), centers.ctypes.data, radii.ctypes.data, order.ctypes.data, n,
-                  flags.ctypes.data, pos.ctypes.data, entries.ctypes.data, 1)
+    lib.grid_fill(rects.ctypes.data, shape.ctypes.data, order.ctypes.data, n, flags.ctypes.data, pos.ctypes.data,
+                  entries.ctypes.data, 1)
     return Grid(faces, shape, start, entries, order[~listed[order]], layout)

@@ -40,8 +40,8 @@ class Shapes(Structure):
 class Grid(Structure):
     _fields_ = [("faces", c_void_p), ("shape", c_void_p), ("start", c_void_p), ("start_count", c_int64),
                 ("entries", c_void_p), ("glob", c_void_p), ("nglob", c_int64), ("u_at", c_void_p),
-                ("v_at", c_void_p), ("n_u", c_int64), ("n_v", c_int64), ("block", c_int64), ("u_sign", c_double),
-                ("v_sign", c_double)]
+                ("v_at", c_void_p), ("n_u", c_int64), ("n_v", c_int64), ("block", c_int64), ("block_rows", c_int64),
+                ("u_sign", c_double), ("v_sign", c_double)]
 
 
 class Band(Structure):
@@ -49,13 +49,14 @@ class Band(Structure):
                 ("rotated", c_int32), ("lit", c_int32), ("width", c_int64), ("row0", c_int64), ("row_magic", c_uint64),
                 ("dirs", c_void_p), ("pc", c_void_p), ("floor", c_void_p), ("grid", Grid),
                 ("bucket_start", c_void_p), ("bucket_pixels", c_void_p), ("slot", c_void_p), ("sqd", c_void_p),
-                ("pt", c_void_p), ("nm", c_void_p), ("bad", c_void_p), ("nan_px", c_void_p)]
+                ("pt", c_void_p), ("nm", c_void_p), ("npix", c_int64), ("bad", c_void_p), ("nan_px", c_void_p)]
 
 
 class LightPass(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("band", POINTER(Band)), ("light", c_void_p), ("scale", c_double * 3),
                 ("frame", c_double * 6), ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
-                ("along", c_void_p), ("radius", c_void_p), ("grid", Grid), ("acc", c_void_p)]
+                ("first", c_int32), ("along", c_void_p), ("behind", c_void_p), ("l_hat", c_double * 3),
+                ("l_len", c_double), ("radius", c_void_p), ("grid", Grid), ("acc", c_void_p)]
 
 
 #: Pixels a band may hold and the widest frame, for Band.row_magic (csrc/kernels.h band_row).
@@ -85,18 +86,19 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
     "pixel_cells": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "nearest": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "origin_terms": (None, [POINTER(Shapes), c_void_p]),
+    "shape_tables": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p,
+                               c_void_p, c_void_p]),
     "shadow_directions": (None, [POINTER(Shapes), c_void_p, c_void_p]),
     "light_pass": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
     "shadow_origins": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
-    "trace_pixel": (c_int64, [POINTER(Band), POINTER(LightPass), c_void_p, c_void_p, c_int64, c_int64, c_int64,
+    "trace_pixel": (c_int64, [POINTER(Band), c_int32, c_int32, c_void_p, c_void_p, c_int64, c_int64, c_int64,
                               c_void_p, c_void_p, c_void_p]),
     "finish": (c_int64, [POINTER(Band), c_void_p, c_void_p, c_int32, c_int64, c_int64, c_void_p, c_void_p,
                          c_void_p]),
 }
 _PLAIN = {
-    "grid_sizes": (None, [POINTER(Grid), c_int32, c_void_p, c_void_p, c_int64, c_void_p]),
-    "grid_fill": (None, [POINTER(Grid), c_int32, c_void_p, c_void_p, c_void_p, c_int64, c_void_p, c_void_p,
-                         c_void_p, c_int32]),
+    "grid_footprints": (None, [POINTER(Grid), c_int32, c_void_p, c_void_p, c_int64, c_void_p]),
+    "grid_fill": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_int32]),
     "bound_radii": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_int32, c_void_p]),
     "bound_floors": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double,
                             c_void_p]),

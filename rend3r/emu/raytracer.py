@@ -29,14 +29,15 @@ from typing import Callable
 
 import numpy as np
 
+from ..isa import Table, lookup
+from ..isa.tables import PROP_LIMIT, SHAPE_TYPE_CODES
 from . import bounds, grids, native
 from .arith import Arith
 from .camera import camera_rays
 from .frame import Frame
 from .lights import POINT, Light, lights_from_scene
 from .options import EmuOptions
-from .scene import Scene
-from .shapes import SPHERE, Shapes, shapes_from_scene
+from .scene import Scene, prop_index
 from .stats import FrameStats
 
 Progress = Callable[[float], None]
@@ -96,10 +97,10 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
     fr = set_up(scene, options)
     w, h, n_pix = options.width, options.height, options.pixels
     st = FrameStats(number=number, pixels=n_pix, shapes=len(fr.sf), lights=len(fr.lights), rays=n_pix)
-    rgb = np.full(n_pix, options.background, dtype=np.uint16)
-    depth = np.full(n_pix, np.inf, dtype=np.float32)
-    prov = np.full(n_pix, -1, dtype=np.int32)
-    if len(fr.sf):
+    rgb, depth, prov = np.empty(n_pix, np.uint16), np.empty(n_pix, np.float32), np.empty(n_pix, np.int32)
+    if not len(fr.sf):  # else every band's finish pass sets every pixel
+        rgb[:], depth[:], prov[:] = options.background, np.inf, -1
+    else:
         rows = max(1, BAND_PIXELS // w)
         for row0 in range(0, h, rows):
             row1 = min(h, row0 + rows)
@@ -121,10 +122,7 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     cam[native.CAM_TMIN], cam[native.CAM_TMAX], cam[native.CAM_Z] = rays.tmin, rays.tmax, rays.z
     if rays.rotation is not None:  # the kernel turns (x[col], y[row], z) per pixel
         cam[native.CAM_ROT:native.CAM_ROT + 4] = [np.asarray(c, dtype) for c in rays.rotation]
-    shapes = shapes_from_scene(scene, ar)
-    sf, si = _shape_tables(shapes, dtype)
-    bnd, bounded = bounds.shape_bounds(sf[:, native.SF_LOC:native.SF_LOC + 3], sf[:, native.SF_ROT:native.SF_ROT + 4],
-                                       sf[:, native.SF_INV:native.SF_INV + 3], shapes.kind == SPHERE)
+    sf, si, bnd, bounded, index = _shape_tables(scene, ar)
     lights = lights_from_scene(scene, ar, options.light_model)
     n = len(sf)
     view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
@@ -132,22 +130,33 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     if n:
         native.kernel("origin_terms", ar.precision, ar.ftz)(byref(view), native.ptr(cam, dtype, (native.CAM_COLUMNS,)))
     return _Frame(ar, dtype, cam, np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype),
-                  rays.rotation is not None, sf, si, shapes.index.astype(np.int32), bnd, bounded, lights,
+                  rays.rotation is not None, sf, si, index, bnd, bounded, lights,
                   _light_rows(lights, dtype), options.jobs or available_cores(), view)
 
 
-def _shape_tables(s: Shapes, dtype: np.dtype) -> tuple[np.ndarray, np.ndarray]:
-    """The kernels' shape tables: floats (SF_COLUMNS, working dtype) and ints (SI_COLUMNS)."""
-    sf = np.zeros((len(s), native.SF_COLUMNS), dtype)
-    for base, values in ((native.SF_LOC, s.loc), (native.SF_ROT, s.rot), (native.SF_INV, s.inv_scale)):
-        for k, v in enumerate(values):
-            sf[:, base + k] = v
-    sf[:, native.SF_ZSIGN], sf[:, native.SF_ONE] = s.zsign, s.one
-    si = np.zeros((len(s), native.SI_COLUMNS), np.int64)
-    r, i, j, k = (sf[:, native.SF_ROT + c] for c in range(4))
-    si[:, native.SI_IDENT] = (r == 1) & (i == 0) & (j == 0) & (k == 0) & ~(np.signbit(i) | np.signbit(j) | np.signbit(k))
-    si[:, native.SI_COLOUR] = s.color
-    return sf, si
+#: The shape table's columns the kernels read, and the type codes of the normal forms.
+_SHAPE_PROPS = np.array([prop_index(Table.SHAPE, name) for name in (
+    "xloc", "yloc", "zloc", "rrot", "irot", "jrot", "krot", "xscl", "yscl", "zscl", "col", "type")], np.int32)
+_KINDS = np.array([SHAPE_TYPE_CODES["sphere"], SHAPE_TYPE_CODES["cylinder"], SHAPE_TYPE_CODES["cone"],
+                   lookup(Table.SHAPE, "type").value_mask], np.int32)
+
+
+def _shape_tables(scene: Scene, ar: Arith) -> tuple[np.ndarray, ...]:
+    """The shapes that are on, as the kernels' tables (csrc/datapath.inc shape_tables):
+    (floats, ints, bounds, bounded, program index), in index order."""
+    table = scene.objects
+    values = np.ascontiguousarray(table.values, np.uint16)
+    index = np.ascontiguousarray(table.index, np.int64)
+    rows = len(index)
+    sf = np.zeros((rows, native.SF_COLUMNS), ar.dtype)
+    si = np.empty((rows, native.SI_COLUMNS), np.int64)
+    bnd = np.empty((rows, native.B_COLUMNS))
+    bounded = np.empty(rows, np.uint8)
+    out = np.empty(rows, np.int32)
+    n = native.kernel("shape_tables", ar.precision, ar.ftz)(
+        native.ptr(values, np.uint16, (rows, PROP_LIMIT)), index.ctypes.data, rows, _SHAPE_PROPS.ctypes.data,
+        _KINDS.ctypes.data, sf.ctypes.data, si.ctypes.data, bnd.ctypes.data, bounded.ctypes.data, out.ctypes.data)
+    return sf[:n], si[:n], bnd[:n], bounded[:n].astype(bool), out[:n]
 
 
 @dataclass(frozen=True)
@@ -167,16 +176,13 @@ def trace_pixel(fr: _Frame, options: EmuOptions, x: int, y: int) -> PixelTrace:
     band = native.Band(pointer(fr.shapes), native.ptr(fr.cam, dtype, (native.CAM_COLUMNS,)),
                        native.ptr(fr.xs, dtype, (options.width,)), native.ptr(fr.ys, dtype, (options.height,)),
                        int(fr.rotated), int(bool(fr.lights)), options.width, y, native.row_magic(options.width))
-    radius = np.full(n, np.inf)
-    lp = native.LightPass(pointer(fr.shapes), pointer(band), None, (0.0, 0.0, 0.0), (0.0,) * 6,
-                          int(options.intensity_fixed), int(n > 1), 0, None, radius.ctypes.data, grids.EMPTY.struct())
     scales = np.array([[((lt.color >> shift) & top) / top for shift, top in _CHANNELS] for lt in fr.lights]).reshape(-1, 3)
     shape_out = np.zeros((n, native.TRACE_SHAPE_VALUES))
     light_out = np.zeros((nl, native.TRACE_LIGHT_VALUES))
     nearest = np.zeros(1, np.int64)
-    colour = fr.kernel("trace_pixel")(byref(band), byref(lp), fr.light_rows.ctypes.data, scales.ctypes.data,
-                                                nl, x, y, shape_out.ctypes.data, light_out.ctypes.data,
-                                                nearest.ctypes.data)
+    colour = fr.kernel("trace_pixel")(byref(band), int(options.intensity_fixed), int(n > 1), fr.light_rows.ctypes.data,
+                                      scales.ctypes.data, nl, x, y, shape_out.ctypes.data, light_out.ctypes.data,
+                                      nearest.ctypes.data)
     return PixelTrace(shape_out, light_out, int(nearest[0]), None if colour < 0 else int(colour))
 
 
@@ -243,12 +249,13 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, st: FrameStats,
     lit = bool(fr.lights)
     a = {  # the band's arrays; the Band block points into them
         "slot": np.empty(n_pix, np.int32), "sqd": np.empty(n_pix, dtype),
-        "pt": np.empty((n_pix if lit else 0, 3), dtype), "nm": np.empty((n_pix if lit else 0, 3), dtype),
-        "bad": np.zeros(n_pix, np.uint8), "nan_px": np.zeros(n_pix, np.uint8),
+        "pt": np.empty((3, n_pix if lit else 0), dtype), "nm": np.empty((3, n_pix if lit else 0), dtype),
+        "bad": np.empty(n_pix, np.uint8), "nan_px": np.empty(n_pix, np.uint8),  # nearest sets every pixel
     }
     band = native.Band(pointer(fr.shapes), native.ptr(fr.cam, dtype, (native.CAM_COLUMNS,)),
                        native.ptr(fr.xs, dtype, (w,)), native.ptr(fr.ys, dtype, (options.height,)),
                        int(fr.rotated), int(lit), w, row0, native.row_magic(w))
+    band.npix = n_pix
     pixels, boxes = _pixel_grid(fr, row0, row1)
     if pixels is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
         a["dirs"] = np.empty((n_pix, 4), dtype)
@@ -269,7 +276,7 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, st: FrameStats,
     st.tests += int(c[native.OUT_TESTS])
     st.nan_tests += int(c[native.OUT_NAN_TESTS])
     st.skipped += n_pix * n - int(c[native.OUT_TESTS])
-    acc = np.zeros((n_pix if lit else 0, 3))
+    acc = np.empty((n_pix if lit else 0, 3))  # the first light pass sets it
     for k in range(len(fr.lights)):
         _light(fr, options, k, band, c, acc, st)
     st.hits += fr.kernel("finish")(byref(band), acc.ctypes.data, fr.index.ctypes.data, options.background, 0, n_pix,
@@ -336,9 +343,13 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
     lp = native.LightPass(pointer(fr.shapes), pointer(band), native.ptr(light, fr.dtype, (native.LT_COLUMNS,)),
                           (*[((colour >> shift) & top) / top for shift, top in _CHANNELS],))
     lp.fixed, lp.shadows, lp.parallel, lp.acc = int(options.intensity_fixed), int(shadows), int(not point), acc.ctypes.data
-    if shadows:  # the block points into grid, radius and along: they live until the pass is done
+    lp.first = int(k == 0)
+    if shadows:  # the block points into grid, radius, along and behind: they live until the pass is done
         grid, radius, along = _shadow_grid(fr, lp, light, hits, n_pix)
         lp.grid, lp.radius, lp.along = grid.struct(), radius.ctypes.data, along.ctypes.data
+        if lp.parallel and grid is not grids.EMPTY:
+            behind = _behind_terms(fr, radius, light)
+            lp.behind, lp.l_len, lp.l_hat[:] = behind.ctypes.data, *_unit(light[native.LT_DIR:native.LT_DIR + 3])
     c = _report(_run(fr.jobs, n_pix, fr.kernel("light_pass"), lp, _OUT))
     st.shadow_rays += int(c[native.OUT_SHADOW_RAYS])
     st.tests += int(c[native.OUT_TESTS])
@@ -399,6 +410,27 @@ def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.n
     along = np.empty((n, 4), fr.dtype)
     fr.kernel("shadow_directions")(byref(fr.shapes), light.ctypes.data, along.ctypes.data)
     return grids.build(boxes, True, flat, radius, np.arange(n, dtype=np.int32), rays_per_cell=32), radius, along
+
+
+def _unit(v: np.ndarray) -> tuple[float, np.ndarray]:
+    """(|v|, v/|v|) in float64."""
+    v = v.astype(np.float64)
+    length = float(np.sqrt((v * v).sum()))
+    return length, v / length
+
+
+def _behind_terms(fr: _Frame, radius: np.ndarray, light: np.ndarray) -> np.ndarray:
+    """Per shape, what the light pass's per-packet behind test needs (csrc/kernels.h
+    LightPass.behind): the centre's depth along l, mean2 and spread2 + 64 uu smax^2 of
+    misses4's behind test (uu at |l|, the one direction length); NaN without a radius."""
+    length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
+    smin, smax = fr.bnd[:, native.B_SMIN], fr.bnd[:, native.B_SMAX]
+    with np.errstate(all="ignore"):
+        uu = fr.ar.unit_roundoff + fr.ar.tiny / np.minimum(1.0, (smin * length) ** 2)
+        out = np.stack([(fr.bnd[:, :3] * unit).sum(axis=1),
+                        (smax**2 + smin**2) / 2, (smax**2 - smin**2) / 2 + 64.0 * uu * smax**2], axis=1)
+    out[~(radius < np.inf)] = np.nan
+    return np.ascontiguousarray(out)
 
 
 def _report_origins(outs: np.ndarray) -> np.ndarray:

@@ -14,9 +14,9 @@ from rend3r.emu import bounds
 from rend3r.emu.arith import make_arith
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.processor import execute
-from rend3r.emu.raytracer import render_frame
+from rend3r.emu.raytracer import render_frame, set_up
 from rend3r.emu.reference import render_reference
-from rend3r.emu.shapes import SPHERE, origin_term, shapes_from_scene, solve, squared_distance, to_object
+from rend3r.emu.shapes import origin_term, shapes_from_scene, solve, squared_distance, to_object
 
 from .scenes import Prog
 
@@ -51,9 +51,8 @@ def test_every_computed_hit_is_within_the_cull_radius_and_beyond_the_depth_floor
     shapes = shapes_from_scene(scene, ar)
     origin = tuple(ar.from_bits(scene.camera_bits(n)) for n in ("xloc", "yloc", "zloc"))
     o64 = np.array([float(c) for c in origin])
-    table, ok = bounds.shape_bounds(np.array([[float(c[0]) for c in shapes.loc]]),
-                                    np.array([[float(c[0]) for c in shapes.rot]]),
-                                    np.array([[float(c[0]) for c in shapes.inv_scale]]), shapes.kind == SPHERE)
+    fr = set_up(scene, EmuOptions(precision=arith[0], subnormals=arith[1]))  # the engine's bound table
+    table, ok = fr.bnd, fr.bounded
     center = table[0, :3]
     d = _rays(ar, center, o64, 1.0 / (inv * min(1.0, stretch)), np.random.default_rng(seed))
     d64 = np.stack([np.asarray(c, np.float64) for c in d], axis=1)

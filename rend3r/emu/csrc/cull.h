@@ -23,7 +23,14 @@ INLINE f64x4 sqrt4(f64x4 x)
     return r;
 }
 
-/* |v|^2 - (v.d)^2/|d|^2 > r^2 is tested times |d|^2, which needs no division. */
+/* Off the line: |v|^2 - (v.d)^2/|d|^2 > r^2, tested times |d|^2 (no division). */
+INLINE i64x4 primary_off4(const double *pc, f64x4 d0, f64x4 d1, f64x4 d2, f64x4 dd)
+{
+    f64x4 vd = pc[PC_V] * d0 + pc[PC_V + 1] * d1 + pc[PC_V + 2] * d2;
+    return pc[PC_VV] * dd - vd * vd > pc[PC_R2] * dd;
+}
+
+/* Off the line, or behind the camera. */
 INLINE i64x4 primary_cull4(const double *pc, f64x4 d0, f64x4 d1, f64x4 d2, f64x4 dd, f64x4 len)
 {
     f64x4 vd = pc[PC_V] * d0 + pc[PC_V + 1] * d1 + pc[PC_V + 2] * d2;

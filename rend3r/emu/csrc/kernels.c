@@ -75,7 +75,7 @@ static int pixel_footprint(const Grid *g, double ulo, double uhi, double vlo, do
     int64_t r0 = search(g->v_at, g->n_v, b0, 0), r1 = search(g->v_at, g->n_v, b1, 1) - 1;
     if (c0 > c1 || r0 > r1)
         return 0;
-    out[0] = c0 / g->block; out[1] = c1 / g->block; out[2] = r0; out[3] = r1;
+    out[0] = c0 / g->block; out[1] = c1 / g->block; out[2] = r0 / g->block_rows; out[3] = r1 / g->block_rows;
     return 1;
 }
 
@@ -117,35 +117,37 @@ static int footprint(const Grid *g, int parallel, int face, const double *c, dou
     return 1;
 }
 
-/* Per shape, the cells its footprint covers (-1: no finite radius, it goes global). */
-void grid_sizes(const Grid *g, int32_t parallel, const double *centers, const double *radii, int64_t n,
-                int64_t *sizes)
+/* Per shape and face, the cell rectangle its footprint covers (out: n x 3 x 4: iu0, iu1,
+ * iv0, iv1; iu0 > iu1 where none, iu0 = -1 for a shape without a finite radius). */
+void grid_footprints(const Grid *g, int32_t parallel, const double *centers, const double *radii, int64_t n,
+                     int64_t *out)
 {
     for (int64_t s = 0; s < n; s++) {
-        if (!(radii[s] < INFINITY)) { sizes[s] = -1; continue; }
-        int64_t total = 0, box[4];
-        for (int face = 0; face < (parallel ? 1 : 3); face++)
-            if (footprint(g, parallel, face, centers + 3 * s, radii[s], box))
-                total += (box[1] - box[0] + 1) * (box[3] - box[2] + 1);
-        sizes[s] = total;
+        for (int face = 0; face < 3; face++) {
+            int64_t *box = out + 12 * s + 4 * face;
+            if (!(radii[s] < INFINITY)) {
+                box[0] = -1; box[1] = -2; box[2] = box[3] = 0;
+            } else if ((parallel && face > 0) || !footprint(g, parallel, face, centers + 3 * s, radii[s], box)) {
+                box[0] = 1; box[1] = box[2] = box[3] = 0;
+            }
+        }
     }
 }
 
-/* Count (fill == 0) or write (fill == 1, pos = each cell's next free entry) the listed
- * shapes of order into their cells. */
-void grid_fill(const Grid *g, int32_t parallel, const double *centers, const double *radii, const int32_t *order,
-               int64_t n, const uint8_t *listed, int64_t *pos, int32_t *entries, int32_t fill)
+/* Count (fill == 0) or write (fill == 1; pos: each cell's next free entry) the listed
+ * shapes of order into the cells of their rectangles (rects as grid_footprints gives
+ * them; shape: per face cells along u, along v, first cell). */
+void grid_fill(const int64_t *rects, const int64_t *shape, const int32_t *order, int64_t n, const uint8_t *listed,
+               int64_t *pos, int32_t *entries, int32_t fill)
 {
     for (int64_t k = 0; k < n; k++) {
         int32_t s = order[k];
         if (!listed[s])
             continue;
-        int64_t box[4];
-        for (int face = 0; face < (parallel ? 1 : 3); face++) {
-            if (!footprint(g, parallel, face, centers + 3 * (int64_t)s, radii[s], box))
-                continue;
-            const int64_t *gs = g->shape + GS_COLUMNS * face;
-            for (int64_t iv = box[2]; iv <= box[3]; iv++) {
+        for (int face = 0; face < 3; face++) {
+            const int64_t *box = rects + 12 * (int64_t)s + 4 * face;
+            const int64_t *gs = shape + GS_COLUMNS * face;
+            for (int64_t iv = box[2]; iv <= box[3] && box[0] <= box[1]; iv++) {
                 int64_t row = gs[GS_FIRST] + iv * gs[GS_NU];
                 for (int64_t iu = box[0]; iu <= box[1]; iu++) {
                     if (fill)

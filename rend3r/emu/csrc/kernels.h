@@ -56,11 +56,11 @@ typedef struct {
     const int32_t *entries; /* shape slots, per cell */
     const int32_t *glob;    /* shape slots every ray tests */
     int64_t nglob;
-    /* A grid camera's pixel grid (face 2 only; u_at NULL otherwise): cells are runs of
-     * `block` columns of one row; u_at holds u_sign * u of every column and v_at v_sign * v
-     * of every row of the band, both ascending. */
+    /* A grid camera's pixel grid (face 2 only; u_at NULL otherwise): cells are blocks of
+     * `block` columns by `block_rows` rows; u_at holds u_sign * u of every column and v_at
+     * v_sign * v of every row of the band, both ascending. */
     const double *u_at, *v_at;
-    int64_t n_u, n_v, block;
+    int64_t n_u, n_v, block, block_rows;
     double u_sign, v_sign;
 } Grid;
 
@@ -80,7 +80,8 @@ typedef struct {            /* the primary rays of one band of rows */
     const int32_t *bucket_pixels;
     int32_t *slot;          /* nearest shape, -1 none */
     void *sqd;              /* its sq_dist, working */
-    void *pt, *nm;          /* pixels x 3, working (lit only) */
+    void *pt, *nm;          /* 3 x pixels (x row, y row, z row), working (lit only) */
+    int64_t npix;           /* pixels of the band */
     uint8_t *bad;           /* hit point, or later a light, not finite */
     uint8_t *nan_px;        /* a ray of the pixel met NaN or infinity */
 } Band;
@@ -94,7 +95,11 @@ typedef struct {            /* one light over one band */
     int32_t fixed;          /* the device's 13-bit intensity converter */
     int32_t shadows;        /* cast shadow rays (there are other shapes) */
     int32_t parallel;       /* directional light: parallel grid, per-shape terms in along */
+    int32_t first;          /* the band's first light: it sets the colour sums instead of adding */
     const void *along;      /* n x 4: l in normal space and a2, working (directional) */
+    const double *behind;   /* n x 3 (directional): centre . l/|l|, and the behind test's mean2
+                               and (spread2 + 64 uu smax^2), NaN where no test applies */
+    double l_hat[3], l_len; /* a directional light's l/|l| and |l| */
     const double *radius;   /* cull radius per shape, for these shadow rays */
     Grid grid;
     double *acc;            /* pixels x 3 colour sums */

@@ -92,6 +92,7 @@ class Grid:
     entries: np.ndarray  # int32 shape positions
     glob: np.ndarray  # int32 shape positions every ray tests
     layout: tuple | None = None  # a pixel grid's (u_at, u_sign, v_at, v_sign, block, block_rows)
+    reach: np.ndarray | None = None  # a pixel grid's (entries, 4) uint8: see csrc/kernels.h Grid.reach
 
     def struct(self) -> native.Grid:
         """The kernels' view (the arrays must outlive it)."""
@@ -104,6 +105,8 @@ class Grid:
             u_at, view.u_sign, v_at, view.v_sign, view.block, view.block_rows = self.layout
             view.u_at, view.v_at = native.ptr(u_at, np.float64, (None,)), native.ptr(v_at, np.float64, (None,))
             view.n_u, view.n_v = len(u_at), len(v_at)
+        if self.reach is not None:
+            view.reach = native.ptr(self.reach, np.uint8, (len(self.entries), 4))
         return view
 
     @property
@@ -228,4 +231,10 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
     pos = start[:-1].copy()
     lib.grid_fill(rects.ctypes.data, shape.ctypes.data, order.ctypes.data, n, flags.ctypes.data, pos.ctypes.data,
                   entries.ctypes.data, 1)
-    return Grid(faces, shape, start, entries, order[~listed[order]], layout)
+    reach = None
+    if pixels is not None:  # what the rest of each list can reach, for packets to stop early
+        reach = np.empty((len(entries), 4), np.uint8)
+        px = np.ascontiguousarray(px)
+        lib.grid_reach(px.ctypes.data, start.ctypes.data, n_cells, entries.ctypes.data, int(shape[2, 0]),
+                       pixels.block, pixels.block_rows, reach.ctypes.data)
+    return Grid(faces, shape, start, entries, order[~listed[order]], layout, reach)

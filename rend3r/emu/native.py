@@ -27,6 +27,7 @@ CAM_ORIGIN, CAM_TMIN, CAM_TMAX, CAM_Z, CAM_ROT, CAM_COLUMNS = 0, 3, 4, 5, 6, 10
 LT_KIND, LT_LOC, LT_DIR, LT_INTENSITY, LT_COLUMNS = 0, 1, 4, 7, 8
 LIGHT_DIRECTIONAL, LIGHT_POINT = 1, 2
 GF_COLUMNS, GS_COLUMNS, BOX_COLUMNS = 6, 3, 7
+GF_SU, GF_SV = 4, 5  # a face's cells per unit of u and of v
 TRACE_SHAPE_VALUES, TRACE_LIGHT_VALUES = 22, 12
 OUT_TESTS, OUT_NAN_TESTS, OUT_SHADOW_RAYS, OUT_HITS, OUT_LO, OUT_HI, OUT_COLUMNS = 0, 1, 2, 3, 4, 7, 10
 PC_COLUMNS = 7
@@ -41,7 +42,7 @@ class Grid(Structure):
     _fields_ = [("faces", c_void_p), ("shape", c_void_p), ("start", c_void_p), ("start_count", c_int64),
                 ("entries", c_void_p), ("glob", c_void_p), ("nglob", c_int64), ("u_at", c_void_p),
                 ("v_at", c_void_p), ("n_u", c_int64), ("n_v", c_int64), ("block", c_int64), ("block_rows", c_int64),
-                ("u_sign", c_double), ("v_sign", c_double)]
+                ("u_sign", c_double), ("v_sign", c_double), ("reach", c_void_p)]
 
 
 class Band(Structure):
@@ -56,7 +57,8 @@ class LightPass(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("band", POINTER(Band)), ("light", c_void_p), ("scale", c_double * 3),
                 ("frame", c_double * 6), ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
                 ("first", c_int32), ("along", c_void_p), ("behind", c_void_p), ("l_hat", c_double * 3),
-                ("l_len", c_double), ("radius", c_void_p), ("grid", Grid), ("acc", c_void_p)]
+                ("l_len", c_double), ("radius", c_void_p), ("reach", c_void_p), ("grid", Grid),
+                ("acc", c_void_p)]
 
 
 #: Pixels a band may hold and the widest frame, for Band.row_magic (csrc/kernels.h band_row).
@@ -99,6 +101,8 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
 _PLAIN = {
     "grid_footprints": (None, [POINTER(Grid), c_int32, c_void_p, c_void_p, c_int64, c_void_p]),
     "grid_fill": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_int32]),
+    "behind_reach": (None, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_double, c_double, c_void_p]),
+    "grid_reach": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_int64, c_int64, c_int64, c_void_p]),
     "bound_radii": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_int32, c_void_p]),
     "bound_floors": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double,
                             c_void_p]),

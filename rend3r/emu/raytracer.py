@@ -344,12 +344,12 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
                           (*[((colour >> shift) & top) / top for shift, top in _CHANNELS],))
     lp.fixed, lp.shadows, lp.parallel, lp.acc = int(options.intensity_fixed), int(shadows), int(not point), acc.ctypes.data
     lp.first = int(k == 0)
-    if shadows:  # the block points into grid, radius, along and behind: they live until the pass is done
-        grid, radius, along = _shadow_grid(fr, lp, light, hits, n_pix)
-        lp.grid, lp.radius, lp.along = grid.struct(), radius.ctypes.data, along.ctypes.data
-        if lp.parallel and grid is not grids.EMPTY:
-            behind = _behind_terms(fr, radius, light)
-            lp.behind, lp.l_len, lp.l_hat[:] = behind.ctypes.data, *_unit(light[native.LT_DIR:native.LT_DIR + 3])
+    if shadows:  # lp points into the shadow grid's arrays: they live until the pass is done
+        sg = _shadow_grid(fr, lp, light, hits, n_pix)
+        lp.grid, lp.radius, lp.along = sg.grid.struct(), sg.radius.ctypes.data, sg.along.ctypes.data
+        if sg.behind is not None:
+            lp.behind, lp.reach = sg.behind.ctypes.data, sg.reach.ctypes.data
+            lp.l_len, lp.l_hat[:] = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     c = _report(_run(fr.jobs, n_pix, fr.kernel("light_pass"), lp, _OUT))
     st.shadow_rays += int(c[native.OUT_SHADOW_RAYS])
     st.tests += int(c[native.OUT_TESTS])
@@ -363,14 +363,26 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
 _ORIGINS = np.concatenate([[np.inf] * 3 + [-np.inf] * 3 + [0.0, 0.0], grids.EMPTY_BOXES.ravel()])
 
 
-def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.ndarray,
-                 n_pix: int) -> tuple[grids.Grid, np.ndarray, np.ndarray]:
+@dataclass
+class _ShadowGrid:
+    """A light's shadow-ray grid over one band, and the per-shape arrays the light pass
+    reads with it (csrc/kernels.h LightPass)."""
+
+    grid: grids.Grid
+    radius: np.ndarray  # cull radius per shape
+    along: np.ndarray  # a directional light's l in normal space and a2, per shape
+    behind: np.ndarray | None = None  # a directional light's behind terms per shape
+    reach: np.ndarray | None = None  # ... and per list entry, what the rest of the list reaches
+
+
+def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.ndarray, n_pix: int) -> _ShadowGrid:
     """The grid of a light's shadow rays from the band's hit points (``lp`` gets its
-    frame): (grid, cull radii, per-shape terms along a directional light's l)."""
+    frame). A directional light's lists run from the shape reaching farthest towards the
+    light, so a packet stops once the rest lies behind its origins."""
     n = len(fr.sf)
     centers = fr.bnd[:, :3]
     along = np.zeros((0, 4), fr.dtype)
-    unbounded = grids.EMPTY, np.full(n, np.inf), along  # every ray tests every shape
+    unbounded = _ShadowGrid(grids.EMPTY, np.full(n, np.inf), along)  # every ray tests every shape
     if not hits[native.OUT_HITS]:
         return unbounded
     lo, hi = hits[native.OUT_LO:native.OUT_LO + 3], hits[native.OUT_HI:native.OUT_HI + 3]
@@ -390,7 +402,8 @@ def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.n
         bounded = fr.bounded & bool(np.isfinite(apex).all())
         radius = bounds.cull_radii(fr.bnd, bounded, far, float(boxes[:, 5].min()), u, tiny, fr.fp16)
         radius += far * (chord * (1 + bounds.SLACK) + 1e-15) + slack
-        return grids.build(boxes, False, centers - apex, radius, np.arange(n, dtype=np.int32)), radius, along
+        return _ShadowGrid(grids.build(boxes, False, centers - apex, radius, np.arange(n, dtype=np.int32)), radius,
+                           along)
     l = light[native.LT_DIR:native.LT_DIR + 3].astype(np.float64)
     length = float(np.sqrt((l * l).sum())) if np.isfinite(l).all() else 0.0
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
@@ -409,7 +422,18 @@ def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.n
         flat[:, :2] = _project(centers, axes)
     along = np.empty((n, 4), fr.dtype)
     fr.kernel("shadow_directions")(byref(fr.shapes), light.ctypes.data, along.ctypes.data)
-    return grids.build(boxes, True, flat, radius, np.arange(n, dtype=np.int32), rays_per_cell=32), radius, along
+    behind = _behind_terms(fr, radius, light)
+    with np.errstate(all="ignore"):  # towards the light first; shapes without a behind test before all
+        ahead = behind[:, 0] + np.maximum(radius, (behind[:, 2] * radius + 0.015625 / length)
+                                          / (behind[:, 1] - behind[:, 2]))
+    order = np.argsort(-np.nan_to_num(ahead, nan=np.inf), kind="stable").astype(np.int32)
+    grid = grids.build(boxes, True, flat, radius, order, rays_per_cell=32)
+    reach = np.empty((len(grid.entries), 3))
+    su, sv = grid.faces[0, native.GF_SU], grid.faces[0, native.GF_SV]
+    diag = float(np.hypot(1 / su, 1 / sv)) if su > 0 and sv > 0 else np.inf  # a cell's diagonal
+    native.library().behind_reach(grid.start.ctypes.data, grid.cells, grid.entries.ctypes.data, behind.ctypes.data,
+                                  radius.ctypes.data, diag, length, reach.ctypes.data)
+    return _ShadowGrid(grid, radius, along, behind, reach)
 
 
 def _unit(v: np.ndarray) -> tuple[float, np.ndarray]:

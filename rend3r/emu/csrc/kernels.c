@@ -159,6 +159,59 @@ void grid_fill(const int64_t *rects, const int64_t *shape, const int32_t *order,
     }
 }
 
+/* A pixel grid's reach (Grid.reach) per entry, from the shapes' pixel rectangles px
+ * (n x 4: first and last column and row); per_row cells per row of blocks. */
+void grid_reach(const int64_t *px, const int64_t *start, int64_t cells, const int32_t *entries, int64_t per_row,
+                int64_t block, int64_t block_rows, uint8_t *out)
+{
+    for (int64_t k = 0; k < cells; k++) {
+        int64_t x = (k % per_row) * block, y = (k / per_row) * block_rows;
+        int64_t r[4] = {block - 1, 0, block_rows - 1, 0};
+        for (int64_t i = start[k + 1] - 1; i >= start[k]; i--) {
+            const int64_t *q = px + 4 * (int64_t)entries[i];
+            r[0] = MIN(r[0], MAX(q[0] - x, 0));
+            r[1] = MAX(r[1], MIN(q[1] - x, block - 1));
+            r[2] = MIN(r[2], MAX(q[2] - y, 0));
+            r[3] = MAX(r[3], MIN(q[3] - y, block_rows - 1));
+            for (int c = 0; c < 4; c++)
+                out[4 * i + c] = (uint8_t)r[c];
+        }
+    }
+}
+
+/* A directional light's reach per entry of its shadow grid (LightPass.reach), from the
+ * behind terms and cull radii per shape; diag: a cell's diagonal, l_len: |l|.
+ *
+ * blocked() skips shape c for a packet when ahead = least - bh0 > 0, mid - spread > r and
+ * l_len (bh1 ahead - bh2 (mid + spread)) > 1/64, mid being the distance from the packet's
+ * centre to c's. The centre lies within spread of every origin, so its depth along l is
+ * at least least - spread (mid >= ahead - spread), and c's footprint meets the cell that
+ * holds the origins, so the centres lie within r + diag + spread of each other across l
+ * (mid <= ahead + 2 spread + r + diag). Hence least >= K2 + 2 spread, K2 = bh0 + r, gives
+ * the first two conditions, and least >= K0 + K1 spread, K0 = bh0 + (b2 (r + diag) +
+ * 1/(64 l_len)) / (bh1 - b2), K1 = 3 b2 / (bh1 - b2), the third (b2: bh2 widened by 1e-8
+ * for the rounding of mid; r likewise). A shape without a test gets infinities. */
+void behind_reach(const int64_t *start, int64_t cells, const int32_t *entries, const double *behind,
+                  const double *radius, double diag, double l_len, double *out)
+{
+    for (int64_t k = 0; k < cells; k++) {
+        double m[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int64_t i = start[k + 1] - 1; i >= start[k]; i--) {
+            const double *bh = behind + 3 * (int64_t)entries[i];
+            double r = radius[entries[i]] * (1.0 + 1e-8), b2 = bh[2] * (1.0 + 1e-8), a = bh[1] - b2;
+            double pad = 1e-12 * (fabs(bh[0]) + r + diag);
+            double key[3] = {bh[0] + (b2 * (r + diag) + 0.015625 / l_len) / a + pad, 3.0 * b2 / a, bh[0] + r + pad};
+            int ok = bh[0] == bh[0] && a > 0 && r < INFINITY;
+            for (int c = 0; c < 3; c++)
+                ok &= key[c] == key[c] && key[c] < INFINITY;
+            for (int c = 0; c < 3; c++) {
+                m[c] = MAX(m[c], ok ? key[c] : INFINITY);
+                out[3 * i + c] = m[c];
+            }
+        }
+    }
+}
+
 /* ---- bounds per shape (rend3r/emu/bounds.py) ---- */
 
 void bound_radii(const double *bnd, const uint8_t *ok, const double *dist, int64_t n, double dmin, double u,

@@ -62,6 +62,10 @@ typedef struct {
     const double *u_at, *v_at;
     int64_t n_u, n_v, block, block_rows;
     double u_sign, v_sign;
+    /* A pixel grid's reach per entry (or NULL): the pixels, relative to the cell's first
+     * column and row, that the entry's shape and every later one of its cell's list may
+     * be hit from (uint8 x0, x1, y0, y1; the union of their footprints). */
+    const uint8_t *reach;
 } Grid;
 
 typedef struct {            /* the primary rays of one band of rows */
@@ -101,6 +105,12 @@ typedef struct {            /* one light over one band */
                                and (spread2 + 64 uu smax^2), NaN where no test applies */
     double l_hat[3], l_len; /* a directional light's l/|l| and |l| */
     const double *radius;   /* cull radius per shape, for these shadow rays */
+    /* Per entry of the grid's lists (directional light; else NULL): K0, K1, K2, the
+     * largest over the entry's shape and every later one of its cell (kernels.c
+     * behind_reach); a packet whose origins lie at depth >= least along l within spread
+     * of their centre skips the rest of the list once least >= max(K0 + K1 spread,
+     * K2 + 2 spread), as every shape left lies behind every origin. */
+    const double *reach;
     Grid grid;
     double *acc;            /* pixels x 3 colour sums */
 } LightPass;

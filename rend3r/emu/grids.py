@@ -92,7 +92,7 @@ class Grid:
     entries: np.ndarray  # int32 shape positions
     glob: np.ndarray  # int32 shape positions every ray tests
     layout: tuple | None = None  # a pixel grid's (u_at, u_sign, v_at, v_sign, block, block_rows)
-    reach: np.ndarray | None = None  # a pixel grid's (entries, 4) uint8: see csrc/kernels.h Grid.reach
+    reach: np.ndarray | None = None  # float32 cones at every fourth entry: see csrc/kernels.h Grid.reach
 
     def struct(self) -> native.Grid:
         """The kernels' view (the arrays must outlive it)."""
@@ -106,7 +106,7 @@ class Grid:
             view.u_at, view.v_at = native.ptr(u_at, np.float64, (None,)), native.ptr(v_at, np.float64, (None,))
             view.n_u, view.n_v = len(u_at), len(v_at)
         if self.reach is not None:
-            view.reach = native.ptr(self.reach, np.uint8, (len(self.entries), 4))
+            view.reach = native.ptr(self.reach, np.float32, (-(-len(self.entries) // 4) * 4,))
         return view
 
     @property
@@ -170,13 +170,15 @@ def _sizes(rects: np.ndarray) -> np.ndarray:
 
 
 def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndarray, order: np.ndarray,
-          pixels: PixelLayout | None = None, rays_per_cell: int = RAYS_PER_CELL) -> Grid:
+          pixels: PixelLayout | None = None, rays_per_cell: int = RAYS_PER_CELL, reach: bool = False) -> Grid:
     """A grid over the rays' per-face ``boxes`` ((3, BOX_COLUMNS): u0, u1, v0, v1, rays, ...;
     no rays: an unused face) listing shapes: ``centers`` (n, 3) relative to the apex, or
     projected (u, v, 0) for a parallel bundle, cull ``radii``, listed in ``order``. With
     ``pixels`` (a grid camera), the cells are blocks of its pixels; else about
     ``rays_per_cell`` rays share a cell. The lists may hold a few entries per ray: coarser
-    cells when they would hold more, then the largest footprints go to the global list."""
+    cells when they would hold more, then the largest footprints go to the global list.
+    With ``reach`` (a perspective bundle), every fourth entry gets the cone of lines the
+    rest of its list may hit."""
     n = len(radii)
     centers = np.ascontiguousarray(centers, np.float64)
     radii = np.ascontiguousarray(radii, np.float64)
@@ -192,14 +194,17 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
                                        np.zeros(0, np.int32), layout).struct()), 0, centers.ctypes.data,
                             radii.ctypes.data, n, rects.ctypes.data)
         px, none = rects[:, 2].copy(), rects[:, 2, 0] > rects[:, 2, 1]
-        while True:
-            rects[:, 2] = px // [pixels.block, pixels.block, pixels.block_rows, pixels.block_rows]
-            rects[none, 2] = (1, 0, 0, 0)
-            sizes = _sizes(rects)
-            total = int(sizes[sizes >= 0].sum())
+        c0, c1, r0, r1 = px[(rects[:, 0, 0] >= 0) & ~none].T  # the listed shapes' pixel rectangles
+        while True:  # the finest blocks whose lists stay within budget
+            total = int((((c1 // pixels.block) - (c0 // pixels.block) + 1)
+                         * ((r1 // pixels.block_rows) - (r0 // pixels.block_rows) + 1)).sum())
             if total <= PIXEL_ENTRIES * pixels.pixels or (pixels.block, pixels.block_rows) == MAX_BLOCK:
                 break
             pixels = pixels.coarser()
+        rects[:, 2] = px // [pixels.block, pixels.block, pixels.block_rows, pixels.block_rows]
+        rects[none, 2] = (1, 0, 0, 0)
+        sizes = _sizes(rects)
+        total = int(sizes[sizes >= 0].sum())
         faces, shape, layout = _pixel_faces(pixels)
         budget = MAX_BUDGET
     else:
@@ -231,10 +236,9 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
     pos = start[:-1].copy()
     lib.grid_fill(rects.ctypes.data, shape.ctypes.data, order.ctypes.data, n, flags.ctypes.data, pos.ctypes.data,
                   entries.ctypes.data, 1)
-    reach = None
-    if pixels is not None:  # what the rest of each list can reach, for packets to stop early
-        reach = np.empty((len(entries), 4), np.uint8)
-        px = np.ascontiguousarray(px)
-        lib.grid_reach(px.ctypes.data, start.ctypes.data, n_cells, entries.ctypes.data, int(shape[2, 0]),
-                       pixels.block, pixels.block_rows, reach.ctypes.data)
-    return Grid(faces, shape, start, entries, order[~listed[order]], layout, reach)
+    cones = None
+    if reach and not parallel:  # the lines the rest of each list may hit, for packets to stop early
+        cones = np.empty(-(-len(entries) // 4) * 4, np.float32)
+        lib.cone_reach(centers.ctypes.data, radii.ctypes.data, start.ctypes.data, n_cells, entries.ctypes.data,
+                       cones.ctypes.data)
+    return Grid(faces, shape, start, entries, order[~listed[order]], layout, cones)

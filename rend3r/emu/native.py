@@ -102,7 +102,7 @@ _PLAIN = {
     "grid_footprints": (None, [POINTER(Grid), c_int32, c_void_p, c_void_p, c_int64, c_void_p]),
     "grid_fill": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_int32]),
     "behind_reach": (None, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_double, c_double, c_void_p]),
-    "grid_reach": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_int64, c_int64, c_int64, c_void_p]),
+    "cone_reach": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_void_p, c_void_p]),
     "bound_radii": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_int32, c_void_p]),
     "bound_floors": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double,
                             c_void_p]),

@@ -323,7 +323,7 @@ def _primary_grid(fr: _Frame, boxes: np.ndarray,
     native.library().bound_primary(fr.bnd.ctypes.data, radius.ctypes.data, len(radius), apex.ctypes.data, dmin, u,
                                    tiny, pc.ctypes.data)
     order = np.argsort(floor, kind="stable").astype(np.int32)
-    return grids.build(boxes, False, centers, radius, order, pixels), floor, pc
+    return grids.build(boxes, False, centers, radius, order, pixels, reach=True), floor, pc
 
 
 #: shadow_origins' output: bounding box of the points, largest magnitude, largest chord,

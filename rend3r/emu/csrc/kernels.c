@@ -159,22 +159,74 @@ void grid_fill(const int64_t *rects, const int64_t *shape, const int32_t *order,
     }
 }
 
-/* A pixel grid's reach (Grid.reach) per entry, from the shapes' pixel rectangles px
- * (n x 4: first and last column and row); per_row cells per row of blocks. */
-void grid_reach(const int64_t *px, const int64_t *start, int64_t cells, const int32_t *entries, int64_t per_row,
-                int64_t block, int64_t block_rows, uint8_t *out)
+/* The double cone (unit axis a, half-angle t; t >= pi/2: every line) around the apex
+ * holding cones 1 and 2 (lines: a2 flipped into a1's hemisphere). */
+static void cone_union(double *a1, double *t1, const double *a2_, double t2)
+{
+    double a2[3] = {a2_[0], a2_[1], a2_[2]}, dot = a1[0] * a2[0] + a1[1] * a2[1] + a1[2] * a2[2];
+    if (dot < 0) {
+        a2[0] = -a2[0]; a2[1] = -a2[1]; a2[2] = -a2[2]; dot = -dot;
+    }
+    double w[3] = {a2[0] - dot * a1[0], a2[1] - dot * a1[1], a2[2] - dot * a1[2]};
+    double sine = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), phi = atan2(sine, dot) * (1.0 + 1e-12) + 1e-15;
+    if (*t1 >= M_PI_2 || phi + t2 <= *t1)
+        return;
+    if (t2 >= M_PI_2 || phi + *t1 <= t2 || !(sine > 1e-9)) {
+        double keep = t2 >= *t1 ? t2 : *t1;
+        if (t2 >= *t1)
+            memcpy(a1, a2, sizeof a2);
+        *t1 = sine > 1e-9 ? t2 : keep + phi;
+        return;
+    }
+    double t = (phi + *t1 + t2) / 2, turn = t - *t1;
+    for (int c = 0; c < 3; c++)
+        a1[c] = cos(turn) * a1[c] + sin(turn) * w[c] / sine;
+    double len = sqrt(a1[0] * a1[0] + a1[1] * a1[1] + a1[2] * a1[2]);
+    for (int c = 0; c < 3; c++)
+        a1[c] /= len;
+    *t1 = t * (1.0 + 1e-12) + 1e-12;
+}
+
+/* A perspective grid's reach (Grid.reach): for each cell, backwards over its list, the
+ * union of the lines' cones of the entry's ball and every later one (centres relative to
+ * the apex, cull radii), written at entries that are multiples of 4. The stored cone is
+ * widened by 1e-6 rad for the float axis (its error is below 1e-7 rad) and its cosine
+ * rounded down. */
+void cone_reach(const double *centers, const double *radii, const int64_t *start, int64_t cells,
+                const int32_t *entries, float *out)
 {
     for (int64_t k = 0; k < cells; k++) {
-        int64_t x = (k % per_row) * block, y = (k / per_row) * block_rows;
-        int64_t r[4] = {block - 1, 0, block_rows - 1, 0};
+        double axis[3] = {0, 0, 1}, angle = -1.0, cos_a = 1.0;
         for (int64_t i = start[k + 1] - 1; i >= start[k]; i--) {
-            const int64_t *q = px + 4 * (int64_t)entries[i];
-            r[0] = MIN(r[0], MAX(q[0] - x, 0));
-            r[1] = MAX(r[1], MIN(q[1] - x, block - 1));
-            r[2] = MIN(r[2], MAX(q[2] - y, 0));
-            r[3] = MAX(r[3], MIN(q[3] - y, block_rows - 1));
-            for (int c = 0; c < 4; c++)
-                out[4 * i + c] = (uint8_t)r[c];
+            const double *c = centers + 3 * (int64_t)entries[i];
+            double r = radii[entries[i]], dist = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+            double a[3] = {c[0] / dist, c[1] / dist, c[2] / dist};
+            int inside = 0;
+            if (angle >= 0 && angle < M_PI_2 && dist > r && r < INFINITY && dist < INFINITY) {
+                /* the ball inside the cone without trigonometry: the angle between the axis and
+                 * the centre plus asin(r / dist) at most the cone's, with room for rounding */
+                double dot = fabs(axis[0] * a[0] + axis[1] * a[1] + axis[2] * a[2]), sr = r / dist;
+                double cr = sqrt(fmax(0.0, 1.0 - sr * sr)), sine = sqrt(fmax(0.0, 1.0 - dot * dot));
+                inside = dot * cr - sine * sr >= cos_a + 1e-9;  /* cos(angle to axis + ball's half-angle) */
+            }
+            if (!inside) {
+                double t = dist > r && r < INFINITY && dist < INFINITY ? asin(r / dist) * (1.0 + 1e-12) + 1e-12 : M_PI_2;
+                if (angle < 0) {
+                    memcpy(axis, a, sizeof a);
+                    angle = t;
+                } else {
+                    cone_union(axis, &angle, a, t);
+                }
+                cos_a = cos(angle);
+            }
+            if (i % 4 == 0) {
+                float *o = out + i;
+                int every = !(angle + 1e-6 < M_PI_2) || !(axis[0] == axis[0]);
+                for (int q = 0; q < 3; q++)
+                    o[q] = every ? 0.0f : (float)axis[q];
+                float cs = (float)cos(angle + 1e-6);
+                o[3] = every ? -2.0f : ((double)cs > cos(angle + 1e-6) ? nextafterf(cs, -INFINITY) : cs);
+            }
         }
     }
 }

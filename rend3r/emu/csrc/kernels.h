@@ -62,10 +62,11 @@ typedef struct {
     const double *u_at, *v_at;
     int64_t n_u, n_v, block, block_rows;
     double u_sign, v_sign;
-    /* A pixel grid's reach per entry (or NULL): the pixels, relative to the cell's first
-     * column and row, that the entry's shape and every later one of its cell's list may
-     * be hit from (uint8 x0, x1, y0, y1; the union of their footprints). */
-    const uint8_t *reach;
+    /* A perspective grid's reach (or NULL), at every fourth entry: a double cone around
+     * the apex (float axis x, y, z and cos of its half-angle, -2 for every line) holding
+     * every line that may hit the entry's shape or a later one of its cell's list
+     * (kernels.c cone_reach); entry i's is at reach + i, i a multiple of 4. */
+    const float *reach;
 } Grid;
 
 typedef struct {            /* the primary rays of one band of rows */

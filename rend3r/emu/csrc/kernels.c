@@ -159,6 +159,8 @@ void grid_fill(const int64_t *rects, const int64_t *shape, const int32_t *order,
     }
 }
 
+#define HALF_PI 1.5707963267948966  /* M_PI_2 is not C11 */
+
 /* The double cone (unit axis a, half-angle t; t >= pi/2: every line) around the apex
  * holding cones 1 and 2 (lines: a2 flipped into a1's hemisphere). */
 static void cone_union(double *a1, double *t1, const double *a2_, double t2)
@@ -169,9 +171,9 @@ static void cone_union(double *a1, double *t1, const double *a2_, double t2)
     }
     double w[3] = {a2[0] - dot * a1[0], a2[1] - dot * a1[1], a2[2] - dot * a1[2]};
     double sine = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), phi = atan2(sine, dot) * (1.0 + 1e-12) + 1e-15;
-    if (*t1 >= M_PI_2 || phi + t2 <= *t1)
+    if (*t1 >= HALF_PI || phi + t2 <= *t1)
         return;
-    if (t2 >= M_PI_2 || phi + *t1 <= t2 || !(sine > 1e-9)) {
+    if (t2 >= HALF_PI || phi + *t1 <= t2 || !(sine > 1e-9)) {
         double keep = t2 >= *t1 ? t2 : *t1;
         if (t2 >= *t1)
             memcpy(a1, a2, sizeof a2);
@@ -202,7 +204,7 @@ void cone_reach(const double *centers, const double *radii, const int64_t *start
             double r = radii[entries[i]], dist = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
             double a[3] = {c[0] / dist, c[1] / dist, c[2] / dist};
             int inside = 0;
-            if (angle >= 0 && angle < M_PI_2 && dist > r && r < INFINITY && dist < INFINITY) {
+            if (angle >= 0 && angle < HALF_PI && dist > r && r < INFINITY && dist < INFINITY) {
                 /* the ball inside the cone without trigonometry: the angle between the axis and
                  * the centre plus asin(r / dist) at most the cone's, with room for rounding */
                 double dot = fabs(axis[0] * a[0] + axis[1] * a[1] + axis[2] * a[2]), sr = r / dist;
@@ -210,7 +212,7 @@ void cone_reach(const double *centers, const double *radii, const int64_t *start
                 inside = dot * cr - sine * sr >= cos_a + 1e-9;  /* cos(angle to axis + ball's half-angle) */
             }
             if (!inside) {
-                double t = dist > r && r < INFINITY && dist < INFINITY ? asin(r / dist) * (1.0 + 1e-12) + 1e-12 : M_PI_2;
+                double t = dist > r && r < INFINITY && dist < INFINITY ? asin(r / dist) * (1.0 + 1e-12) + 1e-12 : HALF_PI;
                 if (angle < 0) {
                     memcpy(axis, a, sizeof a);
                     angle = t;
@@ -221,7 +223,7 @@ void cone_reach(const double *centers, const double *radii, const int64_t *start
             }
             if (i % 4 == 0) {
                 float *o = out + i;
-                int every = !(angle + 1e-6 < M_PI_2) || !(axis[0] == axis[0]);
+                int every = !(angle + 1e-6 < HALF_PI) || !(axis[0] == axis[0]);
                 for (int q = 0; q < 3; q++)
                     o[q] = every ? 0.0f : (float)axis[q];
                 float cs = (float)cos(angle + 1e-6);

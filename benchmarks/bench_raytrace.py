@@ -1,14 +1,20 @@
 """Raytracer speed on the paper's Table IV workloads, beside the paper's device estimate.
 
-Workloads: 1, 16, 256, 4096 spheres with 0 and 1 directional lights at 512x384. Spheres
-stand in a G x G wall of columns K deep (4096 = 16 x 16 x 16), sized so that the front
-layer stays inside float16's range (|D||S| < 128 in normal space; see docs/emulator.md).
-Prints the median wall time per frame over --runs renders (after one warm-up render), the
-device estimate (shapes + 205) * (lights + 1) * pixels cycles at 100 MHz, and
-device/emulator ratios; first, a calibration figure of the machine's numpy speed.
-Targets: fp16 faster than the device on every row; fp32 at least 10x faster.
+Workloads: 1, 16, 256 and 4,096 spheres with 0 and 1 directional lights at 512x384, as the
+sphere walls of walls.py (built to stay in float16's range). Per row and precision: the
+median wall time of ``run_program`` (decoding included) over --runs renders after one
+warm-up, the device estimate (shapes + 205) * (lights + 1) * pixels cycles at 100 MHz, the
+device/emulator ratio and the frame's counters. Threads: --jobs (default 0, every core: the
+device estimate is for the whole device, so the emulator gets the whole machine).
 
-    python benchmarks/bench_raytrace.py [--runs 5] [--shapes 1 16 256 4096] [--precision fp16 fp32] [--rotated]
+Every frame is compared with fp64's (walls.fp16_faithful): it may differ at silhouette
+pixels only. A frame that differs elsewhere measures a broken render: its row prints
+"FP16 FRAME NOT FAITHFUL" (or FP32) and the script exits 1 after the table.
+Target: fp16 at least 100x faster than the device estimate on every row; fp32 is reported.
+First, a calibration figure of the machine's numpy speed.
+
+    python benchmarks/bench_raytrace.py [--runs 5] [--shapes 1 16 256 4096] [--lights 0 1]
+                                        [--precision fp16 fp32] [--jobs 0]
 """
 
 from __future__ import annotations
@@ -18,75 +24,33 @@ import statistics
 import time
 
 import numpy as np
+import walls
 
 from rend3r.emu.options import EmuOptions
-from rend3r.emu.run import run_program
-from rend3r.emu.stats import CLOCK_HZ, device_cycles
-from rend3r.isa import CameraSet, FrameOp, Func, LightSet, ShapeSet, Table, encode, lookup
-from rend3r.isa.float16 import float_to_bits
+from rend3r.emu.raytracer import available_cores
+from rend3r.emu.run import RunResult, run_program
 from rend3r.memory import reuse_freed_memory
 
-LAYOUT = {1: (1, 1), 16: (4, 1), 256: (16, 1), 4096: (16, 16)}  # shapes -> (grid G, depth K)
+SHAPES = (1, 16, 256, 4096)
+#: device time / emulator time, at least, per precision (None: reported only).
+TARGET = {"fp16": 100.0, "fp32": None}
 
 
-def _prop(table: Table, name: str) -> int:
-    return lookup(table, name).index
-
-
-#: --rotated: every sphere turned 30 degrees about (1, 1, 1) (unit quaternion, float16).
-TURN = (0.9658, 0.1494, 0.1494, 0.1494)
-
-
-def workload(shapes: int, lights: int, rotated: bool = False) -> list[int]:
-    """The program: camera, optional light, the sphere wall, nf, er.
-
-    ``rotated`` gives every sphere a rotation: the same image, but the raycaster cannot
-    take its shortcut for unrotated shapes (docs/emulator.md, section 11).
-    """
-    g, k = LAYOUT[shapes]
-    spacing = 8.0 / g
-    inv = 1.0 / (0.45 * spacing)
-    words = list(encode(FrameOp(Func.NR)))
-    for name, value in (("rrot", 1.0), ("hfov", 0.2), ("vfov", 0.2)):
-        words += encode(CameraSet(_prop(Table.CAMERA, name), float_to_bits(value)))
-    if lights:
-        for name, value in (("src", 1), ("xfor", float_to_bits(-0.3)), ("yfor", float_to_bits(-0.4)),
-                            ("zfor", float_to_bits(-1.0)), ("col", 0xFFFF), ("int", float_to_bits(1.0))):
-            words += encode(LightSet(0, _prop(Table.LIGHT, name), value))
-    s = lambda n: _prop(Table.SHAPE, n)  # noqa: E731
-    index = 0
-    for j in range(g):
-        for i in range(g):
-            for d in range(k):
-                x, y, z = (i - (g - 1) / 2) * spacing, (j - (g - 1) / 2) * spacing, -4.0 - d * spacing
-                colour = ((i * 31 // max(1, g - 1)) << 11) | ((j * 63 // max(1, g - 1)) << 5) | (31 - d)
-                for (p1, v1), (p2, v2) in (
-                    (("type", 1), ("col", colour)),
-                    (("xloc", float_to_bits(x)), ("yloc", float_to_bits(y))),
-                    (("zloc", float_to_bits(z)), ("rrot", float_to_bits(TURN[0] if rotated else 1.0))),
-                    (("xscl", float_to_bits(inv)), ("yscl", float_to_bits(inv))),
-                    (("zscl", float_to_bits(inv)), ("mat", 0)),
-                ) + ((("irot", float_to_bits(TURN[1])), ("jrot", float_to_bits(TURN[2]))),
-                     (("krot", float_to_bits(TURN[3])), ("mat", 0))) * rotated:
-                    words += encode(ShapeSet(index, s(p1), s(p2), v1, v2))
-                index += 1
-    return words + list(encode(FrameOp(Func.NF))) + list(encode(FrameOp(Func.ER)))
-
-
-def measure(words: list[int], precision: str, runs: int) -> tuple[float, object]:
-    """Median wall time of ``runs`` renders after one untimed warm-up render."""
-    run_program(words, EmuOptions(precision=precision))
-    times, stats = [], None
+def measure(words: np.ndarray, options: EmuOptions, runs: int) -> tuple[float, RunResult]:
+    """Median wall time of ``runs`` whole ``run_program`` calls after one untimed warm-up,
+    and the last result."""
+    run_program(words, options)
+    times = []
     for _ in range(runs):
         start = time.perf_counter()
-        result = run_program(words, EmuOptions(precision=precision))
+        result = run_program(words, options)
         times.append(time.perf_counter() - start)
-        stats = result.stats.frames[0]
-    return statistics.median(times), stats
+    return statistics.median(times), result
 
 
-def _calibration_us() -> float:
-    """A fixed numpy workload, to compare machines and moments (shared machines drift)."""
+def calibration_us() -> float:
+    """A fixed numpy workload, to compare machines and moments (shared machines drift):
+    the median time of a float32 multiply of 65,536 elements, in microseconds."""
     a = np.linspace(1.0, 2.0, 1 << 16, dtype=np.float32)
     times = []
     for _ in range(7):
@@ -97,30 +61,46 @@ def _calibration_us() -> float:
     return statistics.median(times)
 
 
-def main() -> None:
+def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=5)
-    ap.add_argument("--shapes", type=int, nargs="+", default=[1, 16, 256, 4096], choices=sorted(LAYOUT))
+    ap.add_argument("--shapes", type=int, nargs="+", default=list(SHAPES), choices=SHAPES)
     ap.add_argument("--lights", type=int, nargs="+", default=[0, 1], choices=[0, 1])
-    ap.add_argument("--precision", nargs="+", default=["fp16", "fp32"], choices=["fp16", "fp32", "fp64"])
-    ap.add_argument("--rotated", action="store_true", help="turn every sphere (no shortcut for unrotated shapes)")
+    ap.add_argument("--precision", nargs="+", default=["fp16", "fp32"], choices=sorted(TARGET))
+    ap.add_argument("--jobs", type=int, default=0, help="threads per frame (0: every core)")
     args = ap.parse_args()
-    pixels = 512 * 384
-    print(f"machine: a float32 multiply of 65,536 elements takes {_calibration_us():.1f} us (median of 7)")
+    print(f"machine: a float32 multiply of 65,536 elements takes {calibration_us():.1f} us (median of 7)")
     reuse_freed_memory()  # as the rend3r command does (rend3r/memory.py); the calibration runs before it
+    threads = args.jobs or available_cores()
+    print(f"jobs: {args.jobs} ({threads} thread{'s' * (threads > 1)}); times: median of {args.runs} runs after "
+          "a warm-up, whole run_program;\n'differ (off)': pixels whose shape differs from fp64's (of which off "
+          "silhouettes)")
     print(f"{'shapes':>6} {'lights':>6} {'prec':>5} {'emulator s':>11} {'device s':>9} {'device/emu':>10} "
-          f"{'target':>7} {'tests':>11} {'skipped':>13} {'hits':>7} {'nan':>9}")
+          f"{'target':>12} {'tests':>11} {'hits':>7} {'nan':>9} {'differ (off)':>15}")
+    broken = []
     for lights in args.lights:
         for shapes in args.shapes:
-            words = workload(shapes, lights, args.rotated)
-            device = device_cycles(shapes, lights, pixels) / CLOCK_HZ
+            wall = walls.wall(shapes, lights)
+            reference = run_program(wall.words, EmuOptions(precision="fp64", jobs=args.jobs)).frames[0].provenance
             for precision in args.precision:
-                secs, st = measure(words, precision, args.runs)
-                need = 10.0 if precision == "fp32" else 1.0
-                ok = "met" if device / secs >= need else "MISSED"
-                print(f"{shapes:>6} {lights:>6} {precision:>5} {secs:>11.3f} {device:>9.3f} {device / secs:>10.2f} "
-                      f"{ok:>7} {st.tests:>11} {st.skipped:>13} {st.hits:>7} {st.nan_tests:>9}", flush=True)
+                secs, result = measure(wall.words, EmuOptions(precision=precision, jobs=args.jobs), args.runs)
+                st = result.stats.frames[0]
+                faithful, differ, off = walls.fp16_faithful(result.frames[0].provenance, reference)
+                ratio = st.device_seconds / secs
+                need = TARGET[precision]
+                target = "-" if need is None else f">={need:g}x {'met' if ratio >= need else 'MISSED'}"
+                print(f"{shapes:>6} {lights:>6} {precision:>5} {secs:>11.3f} {st.device_seconds:>9.3f} "
+                      f"{ratio:>10.1f} {target:>12} {st.tests:>11} {st.hits:>7} {st.nan_tests:>9} "
+                      f"{f'{differ} ({off})':>15}", flush=True)
+                if not faithful:
+                    broken.append(f"{shapes} shapes, {lights} light{'s' * (lights != 1)}, {precision}")
+                    print(f"!!! {precision.upper()} FRAME NOT FAITHFUL: {off} pixels show another shape than fp64 "
+                          "off silhouettes; this row's speed measures a broken frame", flush=True)
+    if broken:
+        print(f"\nFAILED: {len(broken)} frame(s) not faithful to fp64: {'; '.join(broken)}")
+        return 1
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

@@ -1,0 +1,344 @@
+"""Speed against a production renderer: the emulator beside Mitsuba 3 on the same sphere walls.
+
+Scenes: walls.wall(n, lights=1) for n in 1, 16, 256, 4,096, 65,536 spheres filling the view,
+512x384, one directional light with shadows; Mitsuba (peer_mitsuba.py) renders the same
+spheres, colours and light. The single-core part pins this process, and with it the
+Mitsuba subprocess, to one CPU; the emulator runs with jobs=1.
+
+Ours, per precision (fp16, fp32, fp64): median of --runs timed ``run_program`` calls after one
+warm-up: "run" is the whole call (decoding the program included, ~655k words at 65,536
+spheres), "render" the frame's render time. fp16 and fp32 frames are checked against fp64's
+with walls.fp16_faithful (they may differ at silhouettes only). Mitsuba, per variant: its
+scene build (objects and BVH) and the median of its timed renders, printed apart; its hit
+mask is compared with our fp64 frame (a check that both render the same scene).
+
+Targets (reported, not asserted): fp32 at most 0.5x the time of Mitsuba scalar_rgb and of
+llvm_ad_rgb, fp16 at most 1x scalar_rgb's, at every size; 16x more spheres (4,096 to 65,536)
+at most 3x the time; jobs=2 at least 1.7x faster than jobs=1 at 4,096 spheres (unpinned).
+Exit status 0, except 1 when an fp32 frame is not faithful to fp64 (a bug).
+
+    python benchmarks/bench_peer.py [--sizes 1 16 256 4096 65536] [--runs 5]
+                                    [--peer scalar_rgb llvm_ad_rgb | --no-peer]
+                                    [--plot PATH] [--markdown PATH]
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import math
+import os
+import shlex
+import statistics
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import walls
+from bench_raytrace import calibration_us
+from peer_mitsuba import VARIANTS, render_spheres
+
+from rend3r.emu import native
+from rend3r.emu.options import EmuOptions
+from rend3r.emu.run import RunResult, run_program
+from rend3r.memory import reuse_freed_memory
+
+SIZES = tuple(sorted(walls.LAYOUT))
+PRECISIONS = ("fp16", "fp32", "fp64")
+WIDTH, HEIGHT = 512, 384
+FP32_VS_PEER = 0.5  # fp32 time / a Mitsuba variant's render time, at most
+FP16_VS_SCALAR = 1.0  # fp16 time / scalar_rgb's render time, at most
+SCALING = 3.0  # time(65,536 spheres) / time(4,096 spheres), at most
+SPEEDUP = 1.7  # jobs=1 time / jobs=2 time at JOBS_SIZE spheres, at least
+JOBS_SIZE = 4096
+#: (label, numerator, denominator, target): numerators are ours ("fp32 run"), denominators
+#: a Mitsuba variant's median render.
+RATIOS = (("fp32 run / scalar", "fp32", "run", "scalar_rgb", FP32_VS_PEER),
+          ("fp32 run / llvm", "fp32", "run", "llvm_ad_rgb", FP32_VS_PEER),
+          ("fp32 render / scalar", "fp32", "render", "scalar_rgb", FP32_VS_PEER),
+          ("fp32 render / llvm", "fp32", "render", "llvm_ad_rgb", FP32_VS_PEER),
+          ("fp16 run / scalar", "fp16", "run", "scalar_rgb", FP16_VS_SCALAR))
+COLOURS = {"fp16": (214, 39, 40), "fp32": (31, 119, 180), "fp64": (44, 160, 44),
+           "scalar_rgb": (148, 103, 189), "llvm_ad_rgb": (255, 127, 14)}
+
+
+@dataclass
+class Ours:
+    """One precision's figures at one size (seconds are medians)."""
+
+    run: float  #: whole run_program
+    render: float  #: stats.frames[0].seconds
+    tests: int
+    hits: int
+    nan_tests: int
+    differ: int  #: pixels whose shape differs from fp64's
+    off: int  #: of which off silhouettes
+
+    @property
+    def faithful(self) -> bool:
+        """The frame shows fp64's shapes everywhere but at silhouettes."""
+        return self.off == 0
+
+
+@dataclass
+class Peer:
+    """One Mitsuba variant's figures at one size."""
+
+    build: float  #: scene build, BVH included
+    render: float  #: median render
+    disagree: float  #: share of pixels whose hit/miss differs from our fp64 frame
+
+
+@dataclass
+class Row:
+    """Everything measured at one size."""
+
+    n: int  #: spheres
+    ours: dict[str, Ours] = field(default_factory=dict)
+    peer: dict[str, Peer] = field(default_factory=dict)
+
+    def ratio(self, precision: str, kind: str, variant: str) -> float | None:
+        """Our ``kind`` time ("run" or "render") over the variant's render time, if measured."""
+        if variant not in self.peer:
+            return None
+        return getattr(self.ours[precision], kind) / self.peer[variant].render
+
+
+def time_ours(words: np.ndarray, precision: str, runs: int, jobs: int) -> tuple[float, float, RunResult]:
+    """Median whole-run and render seconds of ``runs`` timed runs after one warm-up, and the last result."""
+    options = EmuOptions(precision=precision, width=WIDTH, height=HEIGHT, jobs=jobs)
+    run_program(words, options)
+    runs_s, renders = [], []
+    for _ in range(runs):
+        start = time.perf_counter()
+        result = run_program(words, options)
+        runs_s.append(time.perf_counter() - start)
+        renders.append(result.stats.frames[0].seconds)
+    return statistics.median(runs_s), statistics.median(renders), result
+
+
+def verdict(value: float, limit: float, at_most: bool = True) -> str:
+    """"met" or "MISSED": ``value`` against a target of at most (or at least) ``limit``."""
+    return "met" if (value <= limit if at_most else value >= limit) else "MISSED"
+
+
+def measure(n: int, runs: int, variants: list[str]) -> Row:
+    """Our three precisions and the Mitsuba ``variants`` at ``n`` spheres, printing as it goes.
+    A variant that fails is reported and removed from ``variants``."""
+    wall = walls.wall(n, lights=1)
+    k, depth = walls.LAYOUT[n]
+    print(f"\n== {n:,} sphere{'s' * (n > 1)} ({k} x {k}, {depth} deep; {len(wall.words):,} program words)", flush=True)
+    reference = run_program(wall.words, EmuOptions(precision="fp64", width=WIDTH, height=HEIGHT, jobs=1))
+    ref = reference.frames[0].provenance
+    row = Row(n)
+    for precision in PRECISIONS:
+        run, render, result = time_ours(wall.words, precision, runs, jobs=1)
+        st = result.stats.frames[0]
+        _, differ, off = walls.fp16_faithful(result.frames[0].provenance, ref)
+        o = row.ours[precision] = Ours(run, render, st.tests, st.hits, st.nan_tests, differ, off)
+        check = "" if precision == "fp64" else (
+            f"  vs fp64: {differ:,} px differ, {off:,} off silhouettes: "
+            + ("faithful" if o.faithful else f"{precision.upper()} FRAME NOT FAITHFUL"))
+        print(f"  ours {precision:11} run {run:8.4f} s  render {render:8.4f} s  tests {st.tests:>11,}  "
+              f"hits {st.hits:>7,}  nan {st.nan_tests:>9,}{check}", flush=True)
+    for variant in list(variants):
+        try:
+            r = render_spheres(variant, wall.centers, wall.radii, wall.colors, wall.light, width=WIDTH,
+                               height=HEIGHT, hfov=wall.fov, vfov=wall.fov, runs=runs, threads=1)
+        except RuntimeError as e:
+            print(f"  mitsuba {variant} FAILED, skipped from here on: {e}", flush=True)
+            variants.remove(variant)
+            continue
+        p = row.peer[variant] = Peer(r.build_seconds, r.median, float(np.mean(r.hit != (ref >= 0))))
+        print(f"  mitsuba {variant:11} build {p.build:8.4f} s  render {p.render:8.4f} s  "
+              f"hit mask vs our fp64: {100 * p.disagree:.3f}% of pixels differ", flush=True)
+    cells = []
+    for label, precision, kind, variant, limit in RATIOS:
+        value = row.ratio(precision, kind, variant)
+        if value is not None:
+            cells.append(f"{label} {value:.3f} {verdict(value, limit)} (<= {limit:g})")
+    if cells:
+        print("  ratios: " + "; ".join(cells), flush=True)
+    return row
+
+
+def scaling(rows: dict[int, Row]) -> list[str]:
+    """Lines on the cost of 16x more spheres (4,096 to 65,536), if both were measured."""
+    if 4096 not in rows or 65536 not in rows:
+        return ["scaling 4,096 -> 65,536 spheres: not measured (needs --sizes 4096 65536)"]
+    lines = []
+    for precision in ("fp32", "fp16"):
+        a, b = rows[4096].ours[precision], rows[65536].ours[precision]
+        lines.append(f"scaling 4,096 -> 65,536 spheres, {precision}: run {b.run / a.run:.2f}x "
+                     f"{verdict(b.run / a.run, SCALING)}, render {b.render / a.render:.2f}x "
+                     f"{verdict(b.render / a.render, SCALING)} (target <= {SCALING:g}x)")
+    return lines
+
+
+def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
+    """jobs=1 against jobs=2 at JOBS_SIZE spheres, on the unpinned process, printing as it goes."""
+    if len(cpus) < 2:
+        line = f"jobs=2 vs jobs=1: not measured (this process may use {len(cpus)} CPU)"
+        print(line)
+        return [line]
+    wall = walls.wall(JOBS_SIZE, lights=1)
+    lines = []
+    for precision in ("fp32", "fp16"):
+        one = time_ours(wall.words, precision, runs, jobs=1)[0]
+        two = time_ours(wall.words, precision, runs, jobs=2)[0]
+        lines.append(f"jobs, {JOBS_SIZE:,} spheres, {precision} (unpinned, {len(cpus)} CPUs): jobs=1 run {one:.4f} s, "
+                     f"jobs=2 run {two:.4f} s: {one / two:.2f}x faster {verdict(one / two, SPEEDUP, False)} "
+                     f"(target >= {SPEEDUP:g}x)")
+        print(lines[-1], flush=True)
+    return lines
+
+
+def _table(head: list[str], align: list[str], body: list[list[str]]) -> list[str]:
+    """A Markdown table."""
+    return ["| " + " | ".join(cells) + " |" for cells in (head, align, *body)]
+
+
+def markdown(rows: list[Row], variants: list[str], notes: list[str], header: list[str]) -> str:
+    """The results as Markdown: how measured, a times table, a ratios table, the scaling lines."""
+    lines = [*header, "",
+             ("Times in seconds, medians. Ours: *run* is the whole `run_program` call (decoding the program "
+              "included), *render* the frame's render time; one core (`jobs=1`). Mitsuba: *render* is "
+              "`mi.render` plus the copy to numpy, its scene build (objects and BVH) excluded and shown apart; "
+              "one core. *fp16 faithful*: the fp16 frame shows fp64's shape everywhere but at silhouettes."), ""]
+    head = ["spheres", "fp16 run", "fp16 faithful", "fp32 run", "fp32 render", "fp64 run"]
+    head += [f"{v} {what}" for v in variants for what in ("build", "render")]
+    body = []
+    for r in rows:
+        fp16 = r.ours["fp16"]
+        cells = [f"{r.n:,}", f"{fp16.run:.4f}", "yes" if fp16.faithful else f"**no** ({fp16.off:,} px)",
+                 f"{r.ours['fp32'].run:.4f}", f"{r.ours['fp32'].render:.4f}", f"{r.ours['fp64'].run:.4f}"]
+        for v in variants:
+            cells += [f"{r.peer[v].build:.4f}", f"{r.peer[v].render:.4f}"] if v in r.peer else ["-", "-"]
+        body.append(cells)
+    lines += _table(head, ["---:", "---:", ":---:"] + ["---:"] * (len(head) - 3), body)
+    ratios = [x for x in RATIOS if x[3] in variants]
+    if ratios:
+        body = []
+        for r in rows:
+            cells = [f"{r.n:,}"]
+            for _, precision, kind, variant, limit in ratios:
+                value = r.ratio(precision, kind, variant)
+                cells.append("-" if value is None else f"{value:.3f} {verdict(value, limit)}")
+            body.append(cells)
+        lines += ["", "Ratios (our time / Mitsuba's render time; lower is faster), against the targets:", "",
+                  *_table(["spheres", *(f"{label} (<= {limit:g})" for label, *_, limit in ratios)],
+                          ["---:"] * (len(ratios) + 1), body)]
+    lines += ["", *(f"- {note}" for note in notes)]
+    return "\n".join(lines) + "\n"
+
+
+def plot(rows: list[Row], variants: list[str], path: Path) -> None:
+    """Time against spheres, log-log, one line with markers per series, drawn with Pillow."""
+    from PIL import Image, ImageDraw, ImageFont
+
+    series: dict[str, list[tuple[int, float]]] = {
+        **{f"ours {p} (run)": [(r.n, r.ours[p].run) for r in rows] for p in PRECISIONS},
+        **{f"Mitsuba {v} (render)": [(r.n, r.peer[v].render) for r in rows if v in r.peer] for v in variants},
+    }
+    colours = dict(zip(series, [COLOURS[p] for p in PRECISIONS] + [COLOURS[v] for v in variants]))
+    W, H, L, R, T, B = 900, 560, 80, 230, 40, 60
+    img = Image.new("RGB", (W, H), "white")
+    d = ImageDraw.Draw(img)
+    font = ImageFont.load_default(size=13)
+    xs = [n for pts in series.values() for n, _ in pts]
+    ys = [t for pts in series.values() for _, t in pts]
+    x_lo, x_hi = math.floor(math.log10(min(xs))), math.ceil(math.log10(max(xs)))
+    y_lo, y_hi = math.floor(math.log10(min(ys))), math.ceil(math.log10(max(ys)))
+    x_hi, y_hi = max(x_hi, x_lo + 1), max(y_hi, y_lo + 1)
+
+    def at(n: float, t: float) -> tuple[float, float]:
+        return (L + (math.log10(n) - x_lo) / (x_hi - x_lo) * (W - L - R),
+                H - B - (math.log10(t) - y_lo) / (y_hi - y_lo) * (H - T - B))
+
+    d.rectangle([L, T, W - R, H - B], outline="black")
+    for e in range(x_lo, x_hi + 1):
+        x, _ = at(10.0**e, 10.0**y_lo)
+        d.line([x, T, x, H - B], fill=(225, 225, 225))
+        d.line([x, H - B, x, H - B + 5], fill="black")
+        d.text((x - 15, H - B + 8), f"{10**e:,}", fill="black", font=font)
+    for e in range(y_lo, y_hi + 1):
+        _, y = at(10.0**x_lo, 10.0**e)
+        d.line([L, y, W - R, y], fill=(225, 225, 225))
+        d.line([L - 5, y, L, y], fill="black")
+        d.text((L - 70, y - 7), f"{10.0**e:g} s", fill="black", font=font)
+    d.text((L + (W - L - R) // 2 - 120, H - 25), "spheres (log scale), 512x384, one light", fill="black", font=font)
+    d.text((L, 12), "median time per frame, one core (log scale; lower is faster)", fill="black", font=font)
+    for i, (name, pts) in enumerate(series.items()):
+        xy = [at(n, t) for n, t in pts]
+        if len(xy) > 1:
+            d.line(xy, fill=colours[name], width=2)
+        for x, y in xy:
+            d.ellipse([x - 4, y - 4, x + 4, y + 4], fill=colours[name], outline="black")
+        y = T + 10 + 22 * i
+        d.line([W - R + 15, y, W - R + 35, y], fill=colours[name], width=2)
+        d.ellipse([W - R + 21, y - 4, W - R + 29, y + 4], fill=colours[name], outline="black")
+        d.text((W - R + 42, y - 8), name, fill="black", font=font)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    img.save(path)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=list(SIZES), choices=SIZES)
+    ap.add_argument("--runs", type=int, default=5, help="timed runs per measurement; medians are reported")
+    ap.add_argument("--peer", nargs="+", default=list(VARIANTS), choices=VARIANTS, help="Mitsuba variants")
+    ap.add_argument("--no-peer", action="store_true", help="skip Mitsuba")
+    ap.add_argument("--plot", type=Path, help="write a log-log PNG of time against spheres")
+    ap.add_argument("--markdown", type=Path, help="write the results as Markdown")
+    args = ap.parse_args()
+    command = shlex.join(["python", "benchmarks/bench_peer.py", *sys.argv[1:]])
+    cpus = os.sched_getaffinity(0)
+    pinned = min(cpus)
+    # Pins this thread, which renders with jobs=1; Mitsuba's subprocess and later threads inherit it.
+    os.sched_setaffinity(0, {pinned})
+    calibration = f"machine: a float32 multiply of 65,536 elements takes {calibration_us():.1f} us (median of 7)"
+    reuse_freed_memory()  # as the rend3r command does (rend3r/memory.py); the calibration runs before it
+    model = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
+                  if line.startswith("model name")), "unknown")
+    header = [calibration, (f"cpu: {model}; kernels: {native.isa()}; single-core figures pinned to CPU {pinned} "
+                            f"(of {', '.join(map(str, sorted(cpus)))}); {WIDTH}x{HEIGHT}, one light with shadows; "
+                            f"median of {args.runs} timed runs after a warm-up; load average at start "
+                            f"{os.getloadavg()[0]:.2f}")]
+    print("\n".join(header))
+    variants = [] if args.no_peer else list(dict.fromkeys(args.peer))
+    if args.no_peer:
+        print("Mitsuba skipped (--no-peer): no peer figures or ratios")
+    elif importlib.util.find_spec("mitsuba") is None:
+        print("Mitsuba skipped: it is not installed (python -m pip install mitsuba; see peer_mitsuba.py)")
+        variants = []
+    print("ours 'run' = the whole run_program call, decoding the program included; 'render' = the frame's render "
+          "time.\nMitsuba 'render' = median of mi.render + copy to numpy, EXCLUDING its scene build (objects + BVH), "
+          "printed apart as 'build'.\nratios = our time / Mitsuba's render time (lower is faster).")
+    active = list(variants)  # measure() drops a variant that fails
+    rows = {n: measure(n, args.runs, active) for n in sorted(args.sizes)}
+    variants = [v for v in variants if any(v in r.peer for r in rows.values())]
+    print()
+    notes = scaling(rows)
+    print("\n".join(notes))
+    os.sched_setaffinity(0, cpus)  # unpinned: the jobs=2 threads start after this and inherit it
+    notes += jobs_scaling(args.runs, cpus)
+    if args.markdown:
+        header_md = [f"Measured by `{command}`.", "", f"- {calibration}", f"- {header[1]}"]
+        args.markdown.parent.mkdir(parents=True, exist_ok=True)
+        args.markdown.write_text(markdown(list(rows.values()), variants, notes, header_md), encoding="utf-8")
+        print(f"wrote {args.markdown}")
+    if args.plot:
+        plot(list(rows.values()), variants, args.plot)
+        print(f"wrote {args.plot}")
+    bad = [r.n for r in rows.values() if not r.ours["fp32"].faithful]
+    if bad:
+        print(f"\n!!! BUG: the fp32 frame is NOT FAITHFUL to fp64 off silhouettes at "
+              f"{', '.join(f'{n:,}' for n in bad)} spheres (fp32 must match fp64 there)")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,4 +1,4 @@
-"""The ISA table and encoder against the encodings in shared/docs/original-device.md."""
+"""The ISA table and encoder against the encodings of the original device's public RTL."""
 
 from fractions import Fraction
 

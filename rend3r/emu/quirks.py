@@ -1,7 +1,7 @@
 """Original-device behaviours as named switches (``--device-quirk NAME``, ``--profile``).
 
 Each quirk sets one or more :class:`EmuOptions` fields; ``docs/device-profile.md``
-documents each with its source in ``shared/docs/original-device.md``. A profile is a set
+documents each with its source in the original device's public RTL. A profile is a set
 of quirks; quirks apply after the other options, so they win over, e.g., ``--depth``.
 """
 

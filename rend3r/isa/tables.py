@@ -2,7 +2,7 @@
 
 This module is the single source of truth for the encoding. The encoder, decoder,
 assembler, disassembler, emulator and ``docs/isa.md`` all read it; nothing re-types it.
-Sources: the paper's Figures 2-4 and ``shared/docs/original-device.md``.
+Sources: the paper's Figures 2-4 and the original device's public SystemVerilog source.
 """
 
 from __future__ import annotations

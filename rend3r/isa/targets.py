@@ -1,6 +1,6 @@
 """Memory sizes of the original device's builds, for target-aware warnings.
 
-From ``shared/docs/original-device.md``: indices beyond a size alias modulo that size.
+From the original device's public SystemVerilog source: indices beyond a size alias modulo that size.
 """
 
 from __future__ import annotations

@@ -169,6 +169,15 @@ def _sizes(rects: np.ndarray) -> np.ndarray:
     return sizes
 
 
+def _footprints(faces: np.ndarray, shape: np.ndarray, layout: tuple | None, parallel: bool, centers: np.ndarray,
+                radii: np.ndarray, rects: np.ndarray) -> None:
+    """Fill ``rects`` (n, 3, 4) with each shape's cell rectangle per face on a grid of
+    these face tables (csrc/kernels.c grid_footprints)."""
+    empty = Grid(faces, shape, np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0, np.int32), layout)
+    native.library().grid_footprints(byref(empty.struct()), int(parallel), centers.ctypes.data, radii.ctypes.data,
+                                     len(radii), rects.ctypes.data)
+
+
 def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndarray, order: np.ndarray,
           pixels: PixelLayout | None = None, rays_per_cell: int = RAYS_PER_CELL, reach: bool = False) -> Grid:
     """A grid over the rays' per-face ``boxes`` ((3, BOX_COLUMNS): u0, u1, v0, v1, rays, ...;
@@ -190,9 +199,7 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
     if pixels is not None:  # pixel rectangles once; blocks by integer division
         one = replace(pixels, block=1, block_rows=1)
         faces, shape, layout = _pixel_faces(one)
-        lib.grid_footprints(byref(Grid(faces, shape, np.zeros(1, np.int64), np.zeros(0, np.int32),
-                                       np.zeros(0, np.int32), layout).struct()), 0, centers.ctypes.data,
-                            radii.ctypes.data, n, rects.ctypes.data)
+        _footprints(faces, shape, layout, False, centers, radii, rects)
         px, none = rects[:, 2].copy(), rects[:, 2, 0] > rects[:, 2, 1]
         c0, c1, r0, r1 = px[(rects[:, 0, 0] >= 0) & ~none].T  # the listed shapes' pixel rectangles
         while True:  # the finest blocks whose lists stay within budget
@@ -211,9 +218,7 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
         cells = max(1.0, float(boxes[:, 4].sum()) / rays_per_cell)
         while True:
             faces, shape = _layout(boxes, cells)
-            lib.grid_footprints(byref(Grid(faces, shape, np.zeros(1, np.int64), np.zeros(0, np.int32),
-                                           np.zeros(0, np.int32)).struct()), int(parallel), centers.ctypes.data,
-                                radii.ctypes.data, n, rects.ctypes.data)
+            _footprints(faces, shape, None, parallel, centers, radii, rects)
             sizes = _sizes(rects)
             total = int(sizes[sizes >= 0].sum())
             budget = min(MAX_BUDGET, max(MIN_BUDGET, ENTRIES_PER_CELL * int((shape[:, 0] * shape[:, 1]).sum())))

@@ -1,0 +1,137 @@
+"""Run CLI cases in child processes and tally what the reliability report needs.
+
+Each case is one ``python -m rend3r ...`` child, so a crash (a signal) is seen as a crash
+and not as the end of the fuzzer, and each child's own time and peak RSS are measured
+(``os.wait4`` gives the child's resource usage). A case *passes* when the command exits
+0, 1 or 2 and its stderr holds no Python traceback; exit 1 and 2 must come with an
+``error:`` line. Limits: ``timeout`` seconds (a hang is reported, not waited on) and
+``max_rss`` bytes of address space (``RLIMIT_AS``), so a memory blow-up ends as a
+failed case instead of taking the machine.
+
+Used by the long fuzz runs under ``fuzz/``; the hypothesis suites in ``tests/`` run
+in-process with a fixed budget.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+CHILD_MEMORY = 4 << 30
+"""Default address-space limit of one case (4 GiB): beyond it the case fails as a blow-up."""
+
+
+@dataclass(frozen=True)
+class CaseResult:
+    """What one child did."""
+
+    args: tuple[str, ...]
+    returncode: int
+    seconds: float
+    rss_bytes: int
+    stderr: str
+    timed_out: bool
+
+    @property
+    def crashed(self) -> bool:
+        """Killed by a signal (segfault, abort) other than our own timeout."""
+        return self.returncode < 0 and not self.timed_out
+
+    @property
+    def traceback(self) -> bool:
+        return "Traceback (most recent call last)" in self.stderr
+
+    @property
+    def unclear(self) -> bool:
+        """Failed without saying why: exit 1 or 2 with no ``error:`` line."""
+        return self.returncode in (1, 2) and "error:" not in self.stderr.lower()
+
+    @property
+    def ok(self) -> bool:
+        return (self.returncode in (0, 1, 2) and not self.traceback and not self.unclear
+                and not self.timed_out)
+
+
+def run_case(args: list[str], *, stdin: bytes | None = None, cwd: str | Path | None = None,
+             timeout: float = 60.0, max_rss: int = CHILD_MEMORY) -> CaseResult:
+    """Run ``python -m rend3r *args`` in a child and measure its time and its own peak RSS."""
+
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (max_rss, max_rss))
+
+    with tempfile.TemporaryFile() as err, tempfile.TemporaryFile() as given:
+        if stdin is not None:
+            given.write(stdin)
+            given.seek(0)
+        start = time.perf_counter()
+        child = subprocess.Popen([sys.executable, "-m", "rend3r", *args], cwd=cwd,
+                                 stdin=given if stdin is not None else subprocess.DEVNULL,
+                                 stdout=subprocess.DEVNULL, stderr=err,
+                                 preexec_fn=limit, start_new_session=True)
+        timed_out = False
+        while True:
+            pid, status, usage = os.wait4(child.pid, os.WNOHANG)
+            if pid:
+                break
+            if time.perf_counter() - start > timeout:
+                timed_out = True
+                os.killpg(child.pid, signal.SIGKILL)
+                pid, status, usage = os.wait4(child.pid, 0)
+                break
+            time.sleep(0.005)
+        seconds = time.perf_counter() - start
+        child.returncode = os.waitstatus_to_exitcode(status)  # reaped here, not by Popen
+        err.seek(0)
+        text = err.read().decode("utf-8", "replace")
+    return CaseResult(tuple(args), child.returncode, seconds, usage.ru_maxrss * 1024, text,
+                      timed_out)
+
+
+@dataclass
+class Tally:
+    """Counts over many cases of one parser, printed as one row of the report."""
+
+    name: str
+    cases: int = 0
+    tracebacks: int = 0
+    crashes: int = 0
+    hangs: int = 0
+    unclear: int = 0
+    worst_seconds: float = 0.0
+    worst_rss: int = 0
+    worst_args: tuple[str, ...] = ()
+    failures: list[CaseResult] = field(default_factory=list)
+
+    def add(self, result: CaseResult) -> None:
+        self.cases += 1
+        self.tracebacks += result.traceback
+        self.crashes += result.crashed
+        self.hangs += result.timed_out
+        self.unclear += result.unclear
+        if result.seconds > self.worst_seconds:
+            self.worst_seconds, self.worst_args = result.seconds, result.args
+        self.worst_rss = max(self.worst_rss, result.rss_bytes)
+        if not result.ok:
+            self.failures.append(result)
+
+    def report(self) -> str:
+        """One Markdown table row: parser, cases, tracebacks, crashes, hangs, worst time, worst RSS."""
+        return (f"| {self.name} | {self.cases} | {self.tracebacks} | {self.crashes} | {self.hangs} "
+                f"| {self.unclear} | {self.worst_seconds:.2f} s | {self.worst_rss / 2**20:.0f} MiB |")
+
+    def print_failures(self, limit: int = 5) -> None:
+        for result in self.failures[:limit]:
+            print(f"FAILED ({result.returncode}, {result.seconds:.1f} s): {' '.join(result.args)[:200]}",
+                  file=sys.stderr)
+            print(result.stderr[-2000:], file=sys.stderr)
+
+
+HEADER = ("| parser | cases | tracebacks | crashes | hangs | exits without `error:` | worst time "
+          "| worst RSS |\n|---|---:|---:|---:|---:|---:|---:|---:|")

@@ -1,5 +1,6 @@
-"""Atomic file output: a reader never sees a half-written file, and a failed write
-leaves nothing behind."""
+"""File input and output with limits: reads stop at a size cap (so ``/dev/zero``, a FIFO
+or a huge sparse file ends with an error naming the limit), and writes are atomic (a
+reader never sees a half-written file, and a failed write leaves nothing behind)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,36 @@ import secrets
 from pathlib import Path
 
 from .errors import Rend3rError
+
+
+MAX_INPUT = 256 << 20
+"""Default cap on one input file (256 MiB): far above any program the device's memory or
+an octree this tool builds can hold, far below what would exhaust a machine."""
+
+
+def read_limited(path: str | os.PathLike[str], limit: int = MAX_INPUT, *, what: str = "input") -> bytes:
+    """The bytes of ``path``, refused with a :class:`Rend3rError` beyond ``limit`` bytes.
+
+    A regular file's size is checked with ``fstat`` before reading; anything else (a pipe,
+    a character device such as ``/dev/zero``) is read in chunks and refused as soon as it
+    passes the limit, so no more than ``limit`` + one chunk is ever held.
+    """
+    name = os.fspath(path)
+    try:
+        with open(path, "rb") as fh:
+            size = os.fstat(fh.fileno()).st_size
+            if size > limit:
+                raise Rend3rError(f"{name}: {what} is {size:,} bytes; the limit is {limit:,} bytes")
+            chunks: list[bytes] = []
+            total = 0
+            while chunk := fh.read(1 << 20):
+                total += len(chunk)
+                if total > limit:
+                    raise Rend3rError(f"{name}: {what} is larger than the limit of {limit:,} bytes")
+                chunks.append(chunk)
+    except OSError as exc:
+        raise Rend3rError(f"{name}: cannot read: {exc.strerror or exc}") from None
+    return b"".join(chunks)
 
 
 def write_atomic(path: str | os.PathLike[str], data: bytes) -> None:

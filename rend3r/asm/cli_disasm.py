@@ -10,7 +10,7 @@ import click
 from ..errors import Rend3rError
 from ..fileio import write_atomic
 from .disasm import ISA_EXTENSIONS, MODES, disassemble
-from .formats import FORMATS, read_file, read_words
+from .formats import FORMATS, read_file, read_stream
 
 
 @click.command(
@@ -67,7 +67,7 @@ def disasm_command(src: str, out: str | None, mode: str, fmt: str | None, byteor
         raise Rend3rError(f"--mode {mode} does not apply with --isa-ext hybrid: a hybrid program starts with the "
                           "shape table selected and its ts words choose the table")
     if src == "-":
-        words = read_words(sys.stdin.buffer.read(), fmt, "<stdin>", byteorder)
+        words = read_stream(sys.stdin.buffer, fmt, "<stdin>", byteorder)
     else:
         words = read_file(src, fmt, byteorder)
     text = disassemble(words, mode, addresses, isa_ext)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -20,19 +21,35 @@ class LoadedProgram:
 
 
 def load_program(path: str | os.PathLike[str]) -> LoadedProgram:
-    """Assemble ``path`` if it is source (by suffix, or text no memory format accepts)."""
+    """Assemble ``path`` if it is source (by suffix, or text no memory format accepts).
+
+    A file whose suffix names a memory format (``.mem``, ``.bin``, ...) is only read as
+    that format, so a malformed or oversized image is reported as such and never handed
+    to the assembler; the size limits are the readers' (``rend3r.asm.formats.byte_limit``).
+    """
     p = Path(path)
     if p.suffix.lower() in SOURCE_SUFFIXES:
         return _assemble(p)
-    from ..asm.formats import read_file
+    from ..asm.formats import IMAGE_EXTENSIONS, byte_limit, read_file
 
     try:
         return LoadedProgram(list(read_file(p)), None)
     except Rend3rError as as_image:
+        if p.suffix.lower() in IMAGE_EXTENSIONS or not _small_regular_file(p, byte_limit(None)):
+            raise
         try:
             return _assemble(p)
         except Rend3rError:
             raise as_image from None
+
+
+def _small_regular_file(p: Path, limit: int) -> bool:
+    """Whether ``p`` is a regular file of at most ``limit`` bytes (no FIFO, no device)."""
+    try:
+        st = p.stat()
+    except OSError:
+        return False
+    return stat.S_ISREG(st.st_mode) and st.st_size <= limit
 
 
 def _assemble(p: Path) -> LoadedProgram:

@@ -24,7 +24,7 @@ MALFORMED = [
     (b"1\n/* open\n2\n", "mem", r"^x:2:1: unterminated /\* comment$"),
     (b"@ 1\n", "mem", r"^x:1:1: '@' must be followed by a hex address$"),
     (b"1\n2\n@1 3\n", "mem", r"^x:3:1: address @1 goes back over words already read \(next address is @2\)$"),
-    (b"@ffffffff 1\n", "mem", r"^x:1:1: address @ffffffff is beyond the 16777216-word limit$"),
+    (b"@ffffffff 1\n", "mem", r"^x:1:1: address @ffffffff is beyond the 1,048,576-word limit \(@100000\)$"),
     (b"", "mem", r"^x:1:1: empty file: no words$"),
     (b"  \n// only a comment\n", "mem", r"^x:1:1: no words in file$"),
     (b"\x00\x00\x02\x00", "mem", r"^x: not a text file \(control character 0x00 at character 0\)"),
@@ -60,7 +60,7 @@ MALFORMED = [
     (b":03000000000002FB\n:00000001FF\n", "ihex", r"^x:1:1: data from byte address 0x0 to 0x3 covers only part of the 32-bit word at 0x0$"),
     (b":0400000000000200FA\n:0400020000000200F8\n:00000001FF\n", "ihex", r"^x:2:1: data at byte address 0x2 overlaps an earlier record$"),
     (b":03000004000100F8\n:00000001FF\n", "ihex", r"^x:1:2: record type 04 must carry 2 bytes, not 3$"),
-    (b":02000004FFFFFC\n:0400000000000200FA\n:00000001FF\n", "ihex", r"^x:2:1: data at byte address 0xffff0000 is beyond the 16777216-word limit$"),
+    (b":02000004FFFFFC\n:0400000000000200FA\n:00000001FF\n", "ihex", r"^x:2:1: data at byte address 0xffff0000 is beyond the 1,048,576-word limit \(byte address 0x400000\)$"),
     # lst
     (b"   1 | 0001 | 00000200 | nr\n", "lst", r"^x:1:7: address 1 out of sequence \(expected 0\)$"),
     (b"   1 | 0000 | 0000020x | nr\n", "lst", r"^x:1:22: bad hex digit 'x' in word$"),

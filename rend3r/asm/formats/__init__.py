@@ -12,13 +12,14 @@ import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import BinaryIO, Callable
 
 from ...errors import Rend3rError
+from ...fileio import read_limited
 from ..program import Program
 from .binary import read_bin, render_bin
 from .coe import read_coe, render_coe
-from .common import check_byteorder, is_text
+from .common import BYTES_PER_WORD, MAX_WORDS, check_byteorder, is_text
 from .ihex import read_ihex, render_ihex
 from .listing import read_lst, render_lst
 from .mem import read_mem, render_mem, render_mem_annotated
@@ -58,6 +59,8 @@ _READERS: dict[str, Callable[[bytes, str, str], list[int]]] = {
 #: Extensions that name one format. ``.hex`` is absent on purpose: it is used both for
 #: Intel HEX and for ``$readmemh`` files, so such files are told apart by content.
 _EXTENSIONS = {".mem": "mem", ".bin": "bin", ".coe": "coe", ".ihex": "ihex", ".ihx": "ihex", ".lst": "lst"}
+#: Suffixes that make a file a memory image (read as one only, never as source).
+IMAGE_EXTENSIONS = frozenset(_EXTENSIONS)
 
 
 def _check_format(fmt: str) -> None:
@@ -102,20 +105,27 @@ def detect_format(data: bytes, name: str | None = None) -> str:
     if not is_text(data):
         return "bin"
     text = data.decode("utf-8").removeprefix("\ufeff")
-    first = next((line.strip() for line in text.splitlines() if line.strip()), "")
-    if first.startswith(":"):
+    first = len(text) - len(text.lstrip())  # where the first non-blank line starts
+    if text.startswith(":", first):
         return "ihex"
     if _COE_KEY.search(text):
         return "coe"
-    if _LST_ROW.search(text) and not first.startswith(("//", "/*")):
+    if _LST_ROW.search(text) and not text.startswith(("//", "/*"), first):
         return "lst"
     return "mem"
+
+
+def byte_limit(fmt: str | None) -> int:
+    """Largest file read as format ``fmt`` (any format when None): ``MAX_WORDS`` words at
+    that format's ``BYTES_PER_WORD``."""
+    return MAX_WORDS * (BYTES_PER_WORD[fmt] if fmt is not None else max(BYTES_PER_WORD.values()))
 
 
 def read_words(data: bytes, fmt: str | None = None, name: str = "<input>", byteorder: str = "big") -> list[int]:
     """The words of a memory image in format ``fmt`` (detected from content when None).
 
-    ``byteorder`` applies to ``bin`` and ``ihex``. Malformed input raises Rend3rError.
+    ``byteorder`` applies to ``bin`` and ``ihex``. Malformed input, or more bytes than
+    :func:`byte_limit` allows the format, raises Rend3rError.
     """
     check_byteorder(byteorder)
     if fmt is None:
@@ -123,16 +133,23 @@ def read_words(data: bytes, fmt: str | None = None, name: str = "<input>", byteo
             raise Rend3rError(f"{name}: empty file: no words")
         fmt = detect_format(data)
     _check_format(fmt)
+    if len(data) > byte_limit(fmt):
+        raise Rend3rError(f"{name}: {fmt} image is {len(data):,} bytes; the limit is {byte_limit(fmt):,} bytes "
+                          f"({MAX_WORDS:,} words of {BYTES_PER_WORD[fmt]} bytes)")
     return _READERS[fmt](data, name, byteorder)
 
 
 def read_file(path: str | os.PathLike[str], fmt: str | None = None, byteorder: str = "big") -> list[int]:
-    """Read a memory image file; the format is detected by extension, then by content."""
+    """Read a memory image file; the format is detected by extension, then by content.
+
+    The file's size is checked before it is read (:func:`byte_limit` of the format its
+    extension or ``fmt`` names, else of the largest), so a huge or endless file costs nothing.
+    """
     name = os.fspath(path)
-    try:
-        data = Path(path).read_bytes()
-    except OSError as exc:
-        raise Rend3rError(f"{name}: cannot read: {exc.strerror or exc}") from None
+    known = fmt or _EXTENSIONS.get(Path(name).suffix.lower())
+    if known is not None:
+        _check_format(known)
+    data = read_limited(path, byte_limit(known), what=f"{known or 'memory'} image")
     if fmt is None:
         if not data:
             raise Rend3rError(f"{name}: empty file: no words")
@@ -140,4 +157,14 @@ def read_file(path: str | os.PathLike[str], fmt: str | None = None, byteorder: s
     return read_words(data, fmt, name, byteorder)
 
 
-__all__ = ["FORMATS", "Format", "detect_format", "read_file", "read_words", "render"]
+def read_stream(stream: BinaryIO, fmt: str | None = None, name: str = "<stdin>", byteorder: str = "big") -> list[int]:
+    """Read a memory image from ``stream`` (standard input), refused as soon as it passes
+    :func:`byte_limit`, so an endless stream ends with an error."""
+    limit = byte_limit(fmt)
+    data = stream.read(limit + 1)
+    if len(data) > limit:
+        raise Rend3rError(f"{name}: {fmt or 'memory'} image is larger than the limit of {limit:,} bytes")
+    return read_words(data, fmt, name, byteorder)
+
+
+__all__ = ["FORMATS", "IMAGE_EXTENSIONS", "Format", "byte_limit", "detect_format", "read_file", "read_stream", "read_words", "render"]

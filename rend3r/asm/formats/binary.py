@@ -21,5 +21,6 @@ def read_bin(data: bytes, name: str, byteorder: str = "big") -> list[int]:
             f"({len(data) % 4} byte(s) left over at offset {len(data) - len(data) % 4})"
         )
     if len(data) // 4 > MAX_WORDS:
-        raise Rend3rError(f"{name}: more than {MAX_WORDS} words")
+        raise Rend3rError(f"{name}: {len(data):,} bytes is more than the {MAX_WORDS:,}-word limit "
+                          f"({MAX_WORDS * 4:,} bytes)")
     return unpack_words(data, byteorder)

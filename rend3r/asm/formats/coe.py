@@ -7,11 +7,15 @@ import re
 
 from ...errors import Rend3rError
 from ..program import Program
-from .common import MAX_WORDS, WORD_LIMIT, TextInput, count_words
+from .common import MAX_WORDS, WORD_LIMIT, TextInput, count_words, shown
 
 RADIX_KEY = "memory_initialization_radix"
 VECTOR_KEY = "memory_initialization_vector"
 _RADIX_DIGITS = {2: "01", 10: "0123456789", 16: "0123456789abcdefABCDEF"}
+#: Most significant digits a value below 2**32 has in each radix: longer values are
+#: refused before conversion (Python refuses to convert over 4,300 decimal digits).
+_MAX_DIGITS = {2: 32, 10: 10, 16: 8}
+_NOT_DIGIT = {radix: re.compile(f"[^{digits}]") for radix, digits in _RADIX_DIGITS.items()}
 
 
 def render_coe(program: Program) -> bytes:
@@ -24,6 +28,8 @@ def render_coe(program: Program) -> bytes:
     ).encode("ascii")
 
 
+_STATEMENT_START = re.compile(r"[^\s;]")
+_COMMENT = re.compile(r"^[^\S\n]*;[^\n]*", re.M)
 _STATEMENT = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*=", re.S)
 _VECTOR_TOKEN = re.compile(r"(?P<value>[^\s,]+)|(?P<comma>,)|(?P<ws>\s+)")
 
@@ -38,19 +44,16 @@ def read_coe(data: bytes, name: str) -> list[int]:
     words: list[int] | None = None
     pos = 0
     while True:
+        first = _STATEMENT_START.search(text, pos)  # past blanks and empty statements (';;')
+        if first is None:
+            break
+        pos = first.start()
         end = text.find(";", pos)
         if end < 0:
-            rest = text[pos:]
-            if rest.strip():
-                raise src.error(pos + len(rest) - len(rest.lstrip()), "statement not ended by ';'")
-            break
-        if not text[pos:end].strip():
-            pos = end + 1  # an empty statement (';;')
-            continue
+            raise src.error(pos, "statement not ended by ';'")
         m = _STATEMENT.match(text, pos, end)
         if not m:
-            start = pos + len(text[pos:end]) - len(text[pos:end].lstrip())
-            raise src.error(start, "expected 'keyword=value;'")
+            raise src.error(pos, "expected 'keyword=value;'")
         key = m.group(1).lower()
         if key == RADIX_KEY:
             if radix is not None:
@@ -63,7 +66,7 @@ def read_coe(data: bytes, name: str) -> list[int]:
                 raise src.error(m.start(1), f"{VECTOR_KEY} before {RADIX_KEY}")
             words = _read_vector(src, text, m.end(), end, radix)
         else:
-            raise src.error(m.start(1), f"unknown keyword {m.group(1)!r} (expected {RADIX_KEY} or {VECTOR_KEY})")
+            raise src.error(m.start(1), f"unknown keyword {shown(m.group(1))!r} (expected {RADIX_KEY} or {VECTOR_KEY})")
         pos = end + 1
     if words is None:
         raise src.error(len(text), f"no {VECTOR_KEY}")
@@ -72,14 +75,14 @@ def read_coe(data: bytes, name: str) -> list[int]:
 
 def _blank_comments(text: str) -> str:
     """Replace comment lines by spaces, keeping every offset (and so every position)."""
-    return "\n".join(" " * len(line) if line.lstrip().startswith(";") else line for line in text.split("\n"))
+    return _COMMENT.sub(lambda m: " " * len(m.group()), text)
 
 
 def _read_radix(src: TextInput, text: str, start: int, end: int) -> int:
     value = text[start:end].strip()
     if value not in ("2", "10", "16"):
         at = start + len(text[start:end]) - len(text[start:end].lstrip())
-        raise src.error(at, f"unsupported radix {value!r} (expected 2, 10 or 16)")
+        raise src.error(at, f"unsupported radix {shown(value)!r} (expected 2, 10 or 16)")
     return int(value)
 
 
@@ -95,7 +98,7 @@ def _read_vector(src: TextInput, text: str, start: int, end: int, radix: int) ->
         elif m.lastgroup == "value":
             words.append(_parse_value(src, m.group(), m.start(), radix))
             if len(words) > MAX_WORDS:
-                raise src.error(m.start(), f"more than {MAX_WORDS} words")
+                raise src.error(m.start(), f"more than {MAX_WORDS:,} words")
             expect_value = False
     if not words:
         raise src.error(end, "empty memory_initialization_vector")
@@ -105,11 +108,9 @@ def _read_vector(src: TextInput, text: str, start: int, end: int, radix: int) ->
 
 
 def _parse_value(src: TextInput, token: str, pos: int, radix: int) -> int:
-    digits = _RADIX_DIGITS[radix]
-    for i, c in enumerate(token):
-        if c not in digits:
-            raise src.error(pos + i, f"bad radix-{radix} digit {c!r}")
-    value = int(token, radix)
-    if value >= WORD_LIMIT:
-        raise src.error(pos, f"value {token} is over 32 bits")
-    return value
+    bad = _NOT_DIGIT[radix].search(token)
+    if bad is not None:
+        raise src.error(pos + bad.start(), f"bad radix-{radix} digit {bad.group()!r}")
+    if len(token.lstrip("0")) > _MAX_DIGITS[radix] or int(token, radix) >= WORD_LIMIT:
+        raise src.error(pos, f"value {shown(token)} is over 32 bits")
+    return int(token, radix)

@@ -5,18 +5,31 @@ from __future__ import annotations
 
 import re
 import struct
+from collections.abc import Iterator
 
 from ...errors import Rend3rError
 
-#: Largest memory image a reader builds (words). Guards against ``@ffffffff`` or an
-#: Intel HEX record at 4 GiB allocating gigabytes; 16 Mi words is 32 times the largest
-#: program the 19-bit shape index allows for one property per pair.
-MAX_WORDS = 1 << 24
+#: Largest memory image a reader builds (words), addresses included: an ``@ADDR`` or an
+#: Intel HEX address beyond it is refused, not zero-filled. 1 Mi words is 1,024 times the
+#: largest original target's program memory (``rend3r.isa.targets``: 1,024 words), 16
+#: times the virtual device's default load limit, and room for the 655,360-word program of
+#: 65,536 spheres; disassembling it takes seconds and a few hundred MB. (The full 19-bit
+#: shape index space, 14 words per shape, would be 7 Mi words: no build holds it.)
+MAX_WORDS = 1 << 20
 WORD_LIMIT = 1 << 32
 BYTEORDERS = ("big", "little")
 
+#: Most bytes of file per word of image, per format: a file larger than
+#: ``MAX_WORDS * BYTES_PER_WORD[fmt]`` is refused before it is read. ``bin`` is 4;
+#: ``ihex`` fits one-word records with CRLF (21); ``coe`` fits radix 2 (32 digits, comma,
+#: CRLF); ``mem`` and ``lst`` leave room for comments and source text (``mem`` and
+#: ``mem-annotated`` share the extension, so they share the figure).
+BYTES_PER_WORD = {"mem": 64, "mem-annotated": 64, "bin": 4, "coe": 40, "ihex": 24, "lst": 64}
+
 #: Control characters no text format contains (tab, newline, VT, FF and CR are allowed).
 _CONTROL = re.compile("[\x00-\x08\x0e-\x1f\x7f]")
+#: Linear on any text: only a line start can begin a match, and ``\S`` ends the blanks.
+_NON_BLANK_LINE = re.compile(r"^[^\S\n]*\S[^\n]*", re.M)
 
 
 class TextInput:
@@ -31,14 +44,11 @@ class TextInput:
         col = pos - (self.text.rfind("\n", 0, pos) + 1) + 1
         return Rend3rError(f"{self.name}:{line}:{col}: {message}")
 
-    def lines(self) -> list[tuple[int, str]]:
-        """(offset of the line's first character, line without its newline)."""
-        out = []
-        pos = 0
-        for line in self.text.split("\n"):
-            out.append((pos, line))
-            pos += len(line) + 1
-        return out
+    def lines(self) -> Iterator[tuple[int, str]]:
+        """(offset of the line's first character, line without its newline) for each line
+        that is not blank (found in C, so a file of blank lines costs no Python loop)."""
+        for m in _NON_BLANK_LINE.finditer(self.text):
+            yield m.start(), m.group()
 
 
 def decode_text(data: bytes, name: str, fmt: str) -> str:
@@ -93,3 +103,9 @@ def address_width(count: int) -> int:
 def count_words(n: int) -> str:
     """``"1 word"``, ``"5 words"``."""
     return f"{n} word" if n == 1 else f"{n} words"
+
+
+def shown(token: str, limit: int = 24) -> str:
+    """``token`` for an error message: cut to ``limit`` characters with its length said,
+    so a hostile 60 MB number does not become a 60 MB message."""
+    return token if len(token) <= limit else f"{token[:limit]}... ({len(token):,} characters)"

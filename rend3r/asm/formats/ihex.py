@@ -4,6 +4,8 @@ records above 64 KiB; an end-of-file record last."""
 
 from __future__ import annotations
 
+import re
+
 from ...errors import Rend3rError
 from ..program import Program
 from .common import MAX_WORDS, TextInput, pack_words, unpack_words
@@ -37,16 +39,16 @@ def read_ihex(data: bytes, name: str, byteorder: str = "big") -> list[int]:
     """Words of an Intel HEX file (record types 00-05; checksums verified).
 
     Gaps between data records read as zero words; overlapping data, a word only partly
-    covered, data after the end-of-file record or a missing one are errors.
+    covered, data beyond the ``MAX_WORDS`` limit, data after the end-of-file record or a
+    missing one are errors.
     """
     src = TextInput(data, name, "ihex")
-    segments: list[tuple[int, bytes, int]] = []  # (byte address, data, offset of the record)
+    image = bytearray()
+    runs: list[list[int]] = []  # [start, end, offset of its first record, of its last] per contiguous run
     base = 0
     eof_at: int | None = None
     for pos, raw in src.lines():
         line = raw.strip()
-        if not line:
-            continue
         start = pos + len(raw) - len(raw.lstrip())
         if eof_at is not None:
             raise src.error(start, "record after the end-of-file record")
@@ -54,9 +56,17 @@ def read_ihex(data: bytes, name: str, byteorder: str = "big") -> list[int]:
         if rtype == _DATA:
             absolute = base + address
             if absolute + len(payload) > MAX_WORDS * 4:
-                raise src.error(start, f"data at byte address 0x{absolute:x} is beyond the {MAX_WORDS}-word limit")
+                raise src.error(start, f"data at byte address 0x{absolute:x} is beyond the {MAX_WORDS:,}-word "
+                                       f"limit (byte address 0x{MAX_WORDS * 4:x})")
             if payload:
-                segments.append((absolute, payload, start))
+                end = absolute + len(payload)
+                if len(image) < end:
+                    image.extend(bytes(end - len(image)))
+                image[absolute:end] = payload
+                if runs and runs[-1][1] == absolute:
+                    runs[-1][1], runs[-1][3] = end, start
+                else:
+                    runs.append([absolute, end, start, start])
         elif rtype == _EOF:
             eof_at = start
         elif rtype in (_SEGMENT, _LINEAR):
@@ -68,20 +78,26 @@ def read_ihex(data: bytes, name: str, byteorder: str = "big") -> list[int]:
             raise src.error(start + 7, f"unknown record type {rtype:02X}")
     if eof_at is None:
         raise src.error(len(src.text), "no end-of-file record (:00000001FF)")
-    if not segments:
+    if not runs:
         raise src.error(0, "no data records: empty image")
-    return unpack_words(_assemble(src, segments), byteorder)
+    _check_runs(src, runs)
+    return unpack_words(image, byteorder)
+
+
+_NOT_HEX = re.compile(r"[^0-9A-Fa-f]")
 
 
 def _parse_record(src: TextInput, line: str, start: int) -> tuple[int, int, bytes]:
     if line[0] != ":":
         raise src.error(start, "an Intel HEX record starts with ':'")
+    bad = _NOT_HEX.search(line, 1)
+    if bad is not None:
+        raise src.error(start + bad.start(), f"bad hex digit {bad.group()!r}")
     digits = line[1:]
-    for i, c in enumerate(digits):
-        if c not in "0123456789abcdefABCDEF":
-            raise src.error(start + 1 + i, f"bad hex digit {c!r}")
     if len(digits) % 2:
         raise src.error(start, "record has an odd number of hex digits")
+    if len(digits) > 2 * (5 + 255):
+        raise src.error(start, f"record of {len(digits):,} hex digits is longer than any record (520)")
     body = bytes.fromhex(digits)
     if len(body) < 5:
         raise src.error(start, "record too short (at least :LLAAAATTCC)")
@@ -98,23 +114,19 @@ def _expect_length(src: TextInput, start: int, payload: bytes, n: int, rtype: in
         raise src.error(start + 1, f"record type {rtype:02X} must carry {n} bytes, not {len(payload)}")
 
 
-def _assemble(src: TextInput, segments: list[tuple[int, bytes, int]]) -> bytes:
-    """Place the data records in one zero-filled image; every word whole or absent."""
-    segments.sort(key=lambda s: s[0])
-    image = bytearray(segments[-1][0] + len(segments[-1][1]))
-    run_start = segments[0][0]
-    run_end = run_start
-    first_at = last_at = segments[0][2]
-    for address, payload, at in segments:
+def _check_runs(src: TextInput, runs: list[list[int]]) -> None:
+    """Runs of data may not overlap, and each contiguous stretch of data (runs that touch
+    merged) must start and end on a word boundary."""
+    runs.sort(key=lambda r: r[0])
+    run_start, run_end, first_at, last_at = runs[0]
+    for address, end, at, last in runs[1:]:
         if address < run_end:
             raise src.error(at, f"data at byte address 0x{address:x} overlaps an earlier record")
         if address > run_end:
             _check_whole_words(src, run_start, run_end, first_at, last_at)
             run_start, first_at = address, at
-        image[address : address + len(payload)] = payload
-        run_end, last_at = address + len(payload), at
+        run_end, last_at = end, last
     _check_whole_words(src, run_start, run_end, first_at, last_at)
-    return bytes(image)
 
 
 def _check_whole_words(src: TextInput, start: int, end: int, first_at: int, last_at: int) -> None:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 
 from ..program import Program
-from .common import MAX_WORDS, WORD_LIMIT, TextInput, address_width, count_words
+from .common import MAX_WORDS, WORD_LIMIT, TextInput, address_width, count_words, shown
 
 WORDS_PER_ROW = 2
 _WORDS_WIDTH = 9 * WORDS_PER_ROW - 1
@@ -65,7 +65,7 @@ def read_lst(data: bytes, name: str) -> list[int]:
         if m and int(m.group(1), 16) == len(words):
             words.extend(int(w, 16) for w in m.group(2).split())
             if len(words) > MAX_WORDS:
-                raise src.error(pos, f"more than {MAX_WORDS} words")
+                raise src.error(pos, f"more than {MAX_WORDS:,} words")
             continue
         cells = line.split("|", 3)
         if len(cells) < 3:
@@ -76,17 +76,17 @@ def read_lst(data: bytes, name: str) -> list[int]:
         if address is None:
             raise src.error(addr_pos, "missing address")
         if address != len(words):
-            raise src.error(addr_pos, f"address {address:x} out of sequence (expected {len(words):x})")
+            raise src.error(addr_pos, f"address {shown(f'{address:x}')} out of sequence (expected {len(words):x})")
         offset = 0
         for token in cells[2].split():
             offset = cells[2].index(token, offset)
             value = _hex_cell(src, token, words_pos + offset, "word") or 0
             if value >= WORD_LIMIT:
-                raise src.error(words_pos + offset, f"word {token} is over 32 bits")
+                raise src.error(words_pos + offset, f"word {shown(token)} is over 32 bits")
             words.append(value)
             offset += len(token)
         if len(words) > MAX_WORDS:
-            raise src.error(pos, f"more than {MAX_WORDS} words")
+            raise src.error(pos, f"more than {MAX_WORDS:,} words")
     if not words:
         raise src.error(0, "no words in listing")
     return words

@@ -11,7 +11,7 @@ import re
 
 from ...isa.tables import OPCODE, Opcode
 from ..program import Program
-from .common import MAX_WORDS, WORD_LIMIT, TextInput, address_width
+from .common import MAX_WORDS, WORD_LIMIT, TextInput, address_width, shown
 
 
 def render_mem(program: Program) -> bytes:
@@ -78,7 +78,8 @@ def read_mem(data: bytes, name: str) -> list[int]:
     """
     src = TextInput(data, name, "mem")
     text = src.text
-    if _PLAIN.fullmatch(text):  # plain words only, the usual case; problems go the long way
+    # Plain words only, the usual case; problems (and too many lines) go the long way.
+    if text.count("\n") <= MAX_WORDS and _PLAIN.fullmatch(text):
         words = [int(w, 16) for w in text.split()]
         if 0 < len(words) <= MAX_WORDS:
             return words
@@ -88,18 +89,18 @@ def read_mem(data: bytes, name: str) -> list[int]:
         if kind == "word":
             value = int(m.group().replace("_", ""), 16)
             if value >= WORD_LIMIT:
-                raise src.error(m.start(), f"word {m.group()} is over 32 bits")
+                raise src.error(m.start(), f"word {shown(m.group())} is over 32 bits")
             if len(words) >= MAX_WORDS:
-                raise src.error(m.start(), f"more than {MAX_WORDS} words")
+                raise src.error(m.start(), f"more than {MAX_WORDS:,} words")
             words.append(value)
         elif kind == "addr":
             target = int(m.group()[1:].replace("_", ""), 16)
             if target > MAX_WORDS:
-                raise src.error(m.start(), f"address {m.group()} is beyond the {MAX_WORDS}-word limit")
+                raise src.error(m.start(), f"address {shown(m.group())} is beyond the {MAX_WORDS:,}-word limit "
+                                           f"(@{MAX_WORDS:x})")
             if target < len(words):
-                raise src.error(
-                    m.start(), f"address {m.group()} goes back over words already read (next address is @{len(words):x})"
-                )
+                raise src.error(m.start(), f"address {shown(m.group())} goes back over words already read "
+                                           f"(next address is @{len(words):x})")
             words.extend([0] * (target - len(words)))
         elif kind == "bad":
             raise src.error(m.start(), _bad_character(text, m.start()))

@@ -4,6 +4,10 @@ Header (``struct`` format ``<4sHHHHIQ6d``): magic ``b"R3SV"``, version (1), dept
 pointer width in bits, reserved (0), word count (nodes plus far slots), voxel count, and
 the world-space bounds ``min_x min_y min_z max_x max_y max_z`` of the cube the octree's
 normalised [-1, 1]^3 maps to.
+
+A file is untrusted: :func:`decode_svo` checks the header and then the whole node
+structure (:mod:`rend3r.svo.validate`) before any kernel reads a word, and names the
+byte offset of the first bad word.
 """
 
 from __future__ import annotations
@@ -15,8 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import Rend3rError
-from ..fileio import write_atomic
+from ..fileio import MAX_INPUT, read_limited, write_atomic
 from .octree import MAX_DEPTH, Octree
+from .validate import OctreeError, check_octree
 
 MAGIC = b"R3SV"
 VERSION = 1
@@ -41,7 +46,7 @@ def encode_svo(model: SvoModel) -> bytes:
 
 
 def decode_svo(data: bytes, name: str = "<svo>") -> SvoModel:
-    """Parse a ``.svo`` file, checking magic, version, sizes and the depth."""
+    """Parse and validate a ``.svo`` file: header fields, sizes, bounds and every node."""
     if len(data) < _HEADER.size:
         raise Rend3rError(f"{name}: too short for an .svo header")
     magic, version, depth, ptr_bits, _, count, voxels, *bounds = _HEADER.unpack_from(data)
@@ -51,12 +56,22 @@ def decode_svo(data: bytes, name: str = "<svo>") -> SvoModel:
         raise Rend3rError(f"{name}: unsupported .svo version {version}")
     if not 1 <= depth <= MAX_DEPTH or not 4 <= ptr_bits <= 15:
         raise Rend3rError(f"{name}: bad header (depth {depth}, pointer bits {ptr_bits})")
+    if count == 0:
+        raise Rend3rError(f"{name}: byte 12: header claims 0 words (a root node is required)")
     if len(data) != _HEADER.size + 4 * count:
         raise Rend3rError(f"{name}: expected {count} words, file holds {(len(data) - _HEADER.size) / 4:g}")
     if not all(np.isfinite(bounds)) or any(bounds[i] >= bounds[i + 3] for i in range(3)):
         raise Rend3rError(f"{name}: bad bounds {bounds}")
+    if not all(np.isfinite(np.subtract(bounds[3:], bounds[:3]))):
+        raise Rend3rError(f"{name}: bounds {bounds} span more than a float can hold")
     words = np.frombuffer(data, dtype="<u4", offset=_HEADER.size).astype(np.uint32)
-    return SvoModel(Octree(words, depth, ptr_bits), tuple(bounds), voxels)
+    tree = Octree(words, depth, ptr_bits)
+    try:
+        check_octree(tree)
+    except OctreeError as exc:
+        raise Rend3rError(f"{name}: byte {_HEADER.size + 4 * exc.index}: corrupt octree "
+                          f"(word {exc.index}): {exc}") from None
+    return SvoModel(tree, tuple(bounds), voxels)
 
 
 def write_svo(path: str | os.PathLike[str], model: SvoModel) -> None:
@@ -65,10 +80,5 @@ def write_svo(path: str | os.PathLike[str], model: SvoModel) -> None:
 
 
 def read_svo(path: str | os.PathLike[str]) -> SvoModel:
-    """Read a ``.svo`` file."""
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read()
-    except OSError as exc:
-        raise Rend3rError(f"{path}: cannot read: {exc.strerror or exc}") from exc
-    return decode_svo(data, str(path))
+    """Read and validate a ``.svo`` file (at most :data:`rend3r.fileio.MAX_INPUT` bytes)."""
+    return decode_svo(read_limited(path, MAX_INPUT, what=".svo file"), str(path))

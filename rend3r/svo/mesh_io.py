@@ -17,24 +17,43 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import Rend3rError
-from ..fileio import write_atomic
+from ..fileio import read_limited, write_atomic
 
 Mesh = tuple[np.ndarray, np.ndarray]
+MAX_MESH = 64 << 20
+"""Largest mesh or binvox file read (64 MiB): parsing holds several times the file in memory."""
 
 
 def _fan(polys: list[list[int]], name: str) -> np.ndarray:
     tris = [(p[0], p[i], p[i + 1]) for p in polys for i in range(1, len(p) - 1)]
     if not tris:
         raise Rend3rError(f"{name}: no faces")
-    return np.array(tris, dtype=np.int64)
+    try:
+        return np.array(tris, dtype=np.int64)
+    except OverflowError:
+        raise Rend3rError(f"{name}: face refers to a missing vertex (index beyond 64 bits)") from None
 
 
 def _check(verts: np.ndarray, faces: np.ndarray, name: str) -> Mesh:
-    if len(verts) == 0 or not np.all(np.isfinite(verts)):
-        raise Rend3rError(f"{name}: no vertices or non-finite coordinates")
-    if faces.min() < 0 or faces.max() >= len(verts):
-        raise Rend3rError(f"{name}: face refers to a missing vertex")
+    """Vertices present and finite, every face index naming one of them."""
+    if len(verts) == 0:
+        raise Rend3rError(f"{name}: no vertices")
+    bad = np.flatnonzero(~np.all(np.isfinite(verts), axis=1))
+    if len(bad):
+        raise Rend3rError(f"{name}: vertex {bad[0] + 1} has a non-finite coordinate {verts[bad[0]].tolist()}")
+    wrong = np.flatnonzero(np.any((faces < 0) | (faces >= len(verts)), axis=1))
+    if len(wrong):
+        raise Rend3rError(f"{name}: triangle {wrong[0] + 1} refers to a missing vertex "
+                          f"(indices {faces[wrong[0]].tolist()}, {len(verts)} vertices)")
     return verts, faces
+
+
+def _count(text, what: str, limit: int, name: str) -> int:
+    """A non-negative element or list count no larger than ``limit`` (what the data can hold)."""
+    value = int(text)
+    if not 0 <= value <= limit:
+        raise Rend3rError(f"{name}: {what} count {value} is not in 0..{limit} (the file is {limit} bytes)")
+    return value
 
 
 def parse_obj(text: str, name: str = "<obj>") -> Mesh:
@@ -52,6 +71,9 @@ def parse_obj(text: str, name: str = "<obj>") -> Mesh:
                     raise ValueError("vertex needs 3 coordinates")
             elif parts[0] == "f":
                 idx = [int(p.split("/")[0]) for p in parts[1:]]
+                if any(i == 0 or i < -len(verts) for i in idx):
+                    raise ValueError(f"face index out of range (OBJ indices start at 1; "
+                                     f"{len(verts)} vertices so far)")
                 polys.append([i - 1 if i > 0 else len(verts) + i for i in idx])
         except ValueError as exc:
             raise Rend3rError(f"{name}:{lineno}: {exc}") from exc
@@ -80,7 +102,7 @@ def parse_ply(data: bytes, name: str = "<ply>") -> Mesh:
         if p[0] == "format":
             fmt = p[1]
         elif p[0] == "element":
-            elements.append((p[1], int(p[2]), []))
+            elements.append((p[1], _count(p[2], f"element {p[1]!r}", len(data), name), []))
         elif p[0] == "property" and elements:
             if p[1] == "list":
                 elements[-1][2].append((p[4], "list", _PLY_TYPES[p[2]], _PLY_TYPES[p[3]]))
@@ -109,7 +131,7 @@ def parse_ply(data: bytes, name: str = "<ply>") -> Mesh:
                         if len(prop) == 2:
                             row.append(tokens[pos]); pos += 1
                         else:
-                            k = int(tokens[pos]); pos += 1
+                            k = _count(tokens[pos], "list", len(tokens) - pos - 1, name); pos += 1
                             items = [int(t) for t in tokens[pos:pos + k]]; pos += k
                             if el == "face" and prop[0] in ("vertex_indices", "vertex_index"):
                                 polys.append(items)
@@ -134,7 +156,10 @@ def parse_ply(data: bytes, name: str = "<ply>") -> Mesh:
                             pos += np.dtype(prop[1]).itemsize
                             continue
                         ct, it = np.dtype(end_ch + prop[2]), np.dtype(end_ch + prop[3])
-                        k = int(np.frombuffer(buf, ct, 1, pos)[0]); pos += ct.itemsize
+                        if ct.kind == "f" or it.kind == "f":
+                            raise Rend3rError(f"{name}: list property {prop[0]!r} needs integer types")
+                        k = _count(np.frombuffer(buf, ct, 1, pos)[0], "list", len(buf), name)
+                        pos += ct.itemsize
                         items = np.frombuffer(buf, it, k, pos).astype(np.int64).tolist()
                         pos += it.itemsize * k
                         if el == "face" and prop[0] in ("vertex_indices", "vertex_index"):
@@ -213,11 +238,10 @@ def format_stl(verts: np.ndarray, faces: np.ndarray, binary: bool = True) -> byt
 def read_mesh(path: str | os.PathLike[str]) -> Mesh:
     """Read an OBJ, PLY or STL mesh chosen by file extension."""
     p = Path(path)
-    try:
-        data = p.read_bytes()
-    except OSError as exc:
-        raise Rend3rError(f"{p}: cannot read: {exc.strerror or exc}") from exc
     ext = p.suffix.lower()
+    if ext not in (".obj", ".ply", ".stl"):
+        raise Rend3rError(f"{p}: unknown mesh format (use .obj, .ply, .stl or .binvox)")
+    data = read_limited(p, MAX_MESH, what="mesh")
     try:
         if ext == ".obj":
             return parse_obj(data.decode("utf-8", "replace"), str(p))
@@ -225,9 +249,9 @@ def read_mesh(path: str | os.PathLike[str]) -> Mesh:
             return parse_ply(data, str(p))
         if ext == ".stl":
             return parse_stl(data, str(p))
-    except (KeyError, IndexError, ValueError, struct.error) as exc:
-        raise Rend3rError(f"{p}: malformed {ext[1:].upper()} file: {exc}") from exc
-    raise Rend3rError(f"{p}: unknown mesh format (use .obj, .ply, .stl or .binvox)")
+    except (KeyError, IndexError, ValueError, OverflowError, struct.error) as exc:
+        raise Rend3rError(f"{p}: malformed {ext[1:].upper()} file: {exc}") from None
+    raise AssertionError(ext)  # every extension above returns
 
 
 def write_mesh(path: str | os.PathLike[str], verts: np.ndarray, faces: np.ndarray,
@@ -306,11 +330,12 @@ def decode_binvox(data: bytes, name: str = "<binvox>") -> tuple[np.ndarray, int,
 
 
 def read_binvox(path: str | os.PathLike[str]):
+    """Sparse voxels of a binvox file (at most :data:`MAX_MESH` bytes)."""
+    data = read_limited(path, MAX_MESH, what="binvox file")
     try:
-        data = Path(path).read_bytes()
-    except OSError as exc:
-        raise Rend3rError(f"{path}: cannot read: {exc.strerror or exc}") from exc
-    return decode_binvox(data, str(path))
+        return decode_binvox(data, str(path))
+    except (IndexError, ValueError, OverflowError) as exc:
+        raise Rend3rError(f"{path}: malformed binvox file: {exc}") from None
 
 
 def write_binvox(path: str | os.PathLike[str], coords: np.ndarray, dim: int,

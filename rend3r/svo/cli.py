@@ -22,8 +22,36 @@ Examples:
 
 
 @click.group("svo", epilog=_EPILOG)
-def svo_group() -> None:
+@click.pass_context
+def svo_group(ctx: click.Context) -> None:
     """Sparse voxel octrees after the SVO thesis: build, trace, simulate."""
+    import numpy as np
+
+    # every overflow or invalid operation is checked where it matters (non-finite rays,
+    # coordinates, bounds) and reported as an error; numpy's own warnings stay quiet
+    ctx.with_resource(np.errstate(all="ignore"))
+
+
+def _memory(ctx, param, value: str | None) -> int | None:
+    from .budget import parse_bytes
+
+    if value is None:
+        return None
+    try:
+        return parse_bytes(value)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc)) from None
+
+
+def _finite(lo: float, hi: float):
+    """A click callback refusing NaN, infinities and values outside [lo, hi]."""
+
+    def check(ctx, param, value: float) -> float:
+        if not lo <= value <= hi:  # also False for NaN
+            raise click.BadParameter(f"{value} is not in the range {lo:g}..{hi:g}")
+        return value
+
+    return check
 
 
 @svo_group.command("model")
@@ -50,15 +78,25 @@ def model_cmd(name: str, output: str, detail: int | None, ascii_: bool) -> None:
 @click.option("--ptr-bits", type=click.IntRange(4, 15), default=15, show_default=True,
               help="Relative pointer width (smaller forces far pointers).")
 @click.option("--binvox", "binvox_out", default=None, help="Also write the voxels as binvox.")
+@click.option("--max-memory", "max_memory", default=None, callback=_memory, metavar="SIZE",
+              help="Refuse, before voxelising, a build whose estimate exceeds SIZE (e.g. 2G, 512M); "
+                   "default: half the machine's physical memory.")
 def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: int,
-              binvox_out: str | None) -> None:
-    """Voxelise MESH (.obj .ply .stl .binvox) and write the thesis's node format."""
+              binvox_out: str | None, max_memory: int | None) -> None:
+    """Voxelise MESH (.obj .ply .stl .binvox) and write the thesis's node format.
+
+    Writes both outputs (the .svo and, with --binvox, the binvox file) or neither.
+    """
     import numpy as np
 
-    from .fileformat import SvoModel, write_svo
-    from .mesh_io import read_binvox, read_mesh, write_binvox
+    from .budget import check_budget, default_budget
+    from .fileformat import SvoModel, encode_svo
+    from .mesh_io import encode_binvox, read_binvox, read_mesh
     from .octree import build_octree
+    from .outputs import write_all
     from .voxelize import voxelize
+
+    budget = max_memory or default_budget()
 
     start = time.perf_counter()
     if Path(mesh).suffix.lower() == ".binvox":
@@ -71,19 +109,25 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
         lo = np.asarray(translate, dtype=np.float64)
         if solid:
             raise Rend3rError("--solid applies to meshes; binvox voxels are used as stored")
+        if not (np.all(np.isfinite(lo)) and np.isfinite(h) and h > 0
+                and np.all(np.isfinite(lo + h * (1 << depth)))):
+            raise Rend3rError(f"{mesh}: binvox translate and scale must be finite, scale positive")
+        check_budget(len(coords), budget, mesh)
     else:
         if depth is None:
             raise Rend3rError("--depth is required for mesh input")
         verts, faces = read_mesh(mesh)
         try:
-            coords, lo, h = voxelize(verts, faces, depth, solid)
+            coords, lo, h = voxelize(verts, faces, depth, solid, budget)
         except Rend3rError as exc:
             raise Rend3rError(f"{mesh}: {exc}") from None
     tree = build_octree(coords, depth, ptr_bits)
     hi = lo + h * (1 << depth)
-    write_svo(output, SvoModel(tree, tuple(float(x) for x in lo) + tuple(float(x) for x in hi), len(coords)))
+    bounds = tuple(float(x) for x in lo) + tuple(float(x) for x in hi)
+    outputs = [(output, encode_svo(SvoModel(tree, bounds, len(coords))))]
     if binvox_out:
-        write_binvox(binvox_out, coords, 1 << depth, tuple(lo), h * (1 << depth))
+        outputs.append((binvox_out, encode_binvox(coords, 1 << depth, tuple(lo), h * (1 << depth))))
+    write_all(outputs)
     click.echo(f"{output}: depth {depth}, {len(coords)} voxels, {len(tree.words)} words "
                f"({tree.far_count()} far pointers), {time.perf_counter() - start:.2f} s")
 
@@ -101,16 +145,25 @@ def _kernel(kernel: str, fixed: bool) -> str:
     return use
 
 
-def _place(value: str | None):
+MAX_PLACE = 65504.0
+"""Largest --place coordinate or half size: the largest float16, the device's scene range."""
+
+
+def _place(ctx, param, value: str | None):
+    """``--place X,Y,Z,S`` -> the world box (x - s, y - s, z - s, x + s, y + s, z + s)."""
     if value is None:
         return None
     try:
         x, y, z, s = (float(v) for v in value.split(","))
     except ValueError:
         raise click.BadParameter("expected X,Y,Z,HALF_SIZE") from None
-    if not s > 0:
-        raise click.BadParameter("HALF_SIZE must be positive")
-    return (x - s, y - s, z - s, x + s, y + s, z + s)
+    if not (all(abs(v) <= MAX_PLACE for v in (x, y, z)) and 0 < s <= MAX_PLACE):
+        raise click.BadParameter(f"X, Y, Z must be finite within +-{MAX_PLACE:g} and "
+                                 f"HALF_SIZE in (0, {MAX_PLACE:g}] (float16 scene range)")
+    bounds = (x - s, y - s, z - s, x + s, y + s, z + s)
+    if any(bounds[i] >= bounds[i + 3] for i in range(3)):
+        raise click.BadParameter(f"HALF_SIZE {s:g} is too small to resolve at that position")
+    return bounds
 
 
 @svo_group.command("render")
@@ -124,24 +177,30 @@ def _place(value: str | None):
 @click.option("--kernel", type=click.Choice(["auto", "numba", "numpy"]), default="auto", show_default=True,
               help="Traversal: compiled numba kernel (pip install 'rend3r[fast]') or numpy; "
                    "auto = numba if installed. Identical results.")
-@click.option("--azimuth", type=float, default=35.0, show_default=True)
-@click.option("--elevation", type=float, default=25.0, show_default=True)
-@click.option("--distance", type=click.FloatRange(min=0.1), default=1.6, show_default=True,
-              help="Camera distance in half-diagonals of the model's cube.")
+@click.option("--azimuth", type=float, default=35.0, show_default=True, callback=_finite(-1e6, 1e6),
+              help="Degrees around the vertical axis (-1e6..1e6).")
+@click.option("--elevation", type=float, default=25.0, show_default=True, callback=_finite(-89.9, 89.9),
+              help="Degrees above the horizon (-89.9..89.9).")
+@click.option("--distance", type=float, default=1.6, show_default=True, callback=_finite(0.1, 1e6),
+              help="Camera distance in half-diagonals of the model's cube (0.1..1e6).")
 @click.option("--cost", "cost_path", default=None, help="Also write the per-ray cost image.")
 @click.option("--stats", "show_stats", is_flag=True, help="Print traversal statistics as JSON.")
 @click.option("--with-program", "program", default=None, type=click.Path(dir_okay=False),
               help="Merge into the frames of this REND3R program (its camera is used).")
-@click.option("--place", default=None, help="With --with-program: model centre and half size X,Y,Z,S.")
+@click.option("--place", default=None, callback=_place, help="With --with-program: model centre and half size X,Y,Z,S.")
 def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: bool, kernel: str,
                azimuth: float, elevation: float, distance: float, cost_path: str | None,
-               show_stats: bool, program: str | None, place: str | None) -> None:
-    """Trace MODEL.svo and write an image (depth or shaded)."""
+               show_stats: bool, program: str | None, place: tuple[float, ...] | None) -> None:
+    """Trace MODEL.svo and write an image (depth or shaded).
+
+    Writes every output (the image and, with --cost, the cost image) or none.
+    """
     from PIL import Image
 
-    from ..emu.image import check_output, write_image
+    from ..emu.image import check_output
     from .camera import model_matrix, orbit_camera
     from .fileformat import read_svo
+    from .outputs import write_all
     from .render import cost_image, render
 
     for path in (output, cost_path):
@@ -153,12 +212,12 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
         from ..emu.image import rgb565_to_rgb888
         from .hybrid import program_hybrid
 
-        bounds = _place(place) or svo.bounds
+        bounds = place or svo.bounds
         frames = program_hybrid(svo, program, model_matrix(bounds), size[0], size[1], stack,
                                 kernel=kernel)
         if not frames:
             raise Rend3rError(f"{program}: the program renders no frame")
-        write_image(output, Image.fromarray(rgb565_to_rgb888(frames[0][0])))
+        write_all([(output, _png(Image.fromarray(rgb565_to_rgb888(frames[0][0]))))])
         click.echo(f"{output}: hybrid frame, {size[0]}x{size[1]}")
         return
     if place is not None:
@@ -167,9 +226,10 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
     start = time.perf_counter()
     r = render(svo, cam, stack, not use_float, mode, kernel=kernel)
     elapsed = time.perf_counter() - start
-    write_image(output, Image.fromarray(r.rgb))
+    outputs = [(output, _png(Image.fromarray(r.rgb)))]
     if cost_path:
-        write_image(cost_path, Image.fromarray(cost_image(r.cost)))
+        outputs.append((cost_path, _png(Image.fromarray(cost_image(r.cost)))))
+    write_all(outputs)
     stats = r.result.stats()
     stats["seconds"] = round(elapsed, 3)
     stats["rays_per_s"] = round(stats["rays"] / max(elapsed, 1e-9))
@@ -178,6 +238,15 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
     else:
         click.echo(f"{output}: {stats['hits']}/{stats['rays']} hits, "
                    f"{stats['requests_per_ray']:.2f} requests/ray, {elapsed:.2f} s")
+
+
+def _png(image) -> bytes:
+    """A PIL image encoded as PNG bytes."""
+    import io
+
+    buf = io.BytesIO()
+    image.save(buf, format="PNG")
+    return buf.getvalue()
 
 
 @svo_group.command("sweep")
@@ -189,16 +258,15 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
 @click.option("--jobs", type=click.IntRange(1, 64), default=2, show_default=True, help="Worker processes.")
 def sweep_cmd(model: str, output: str, size, views: int, jobs: int) -> None:
     """Simulate the design points of the thesis's Tables 7.1 and 8.2 on MODEL.svo."""
-    from ..fileio import write_atomic
     from .fileformat import read_svo
+    from .outputs import write_all
     from .sweep import run_sweep, thesis_points, to_csv, to_markdown
 
     _kernel("auto", True)
     svo = read_svo(model)
     start = time.perf_counter()
     rows = run_sweep(svo, thesis_points(), size[0], size[1], views, jobs)
-    write_atomic(output + ".csv", to_csv(rows).encode())
     header = (f"# SVO design sweep: {Path(model).name}, {size[0]}x{size[1]}, {views} view(s)\n\n"
               "Frame times from the model in rend3r/svo/cores.py (50 MHz, 95 MB/s).\n\n")
-    write_atomic(output + ".md", (header + to_markdown(rows)).encode())
+    write_all([(output + ".csv", to_csv(rows).encode()), (output + ".md", (header + to_markdown(rows)).encode())])
     click.echo(f"{output}.csv, {output}.md: {len(rows)} design points, {time.perf_counter() - start:.1f} s")

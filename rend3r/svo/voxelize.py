@@ -17,8 +17,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import Rend3rError
+from .budget import BASE, BYTES_PER_VOXEL, check_budget, estimate_voxels
 
 _CHUNK = 1 << 19  # candidate (triangle, voxel) pairs per vectorised batch
+MAX_COORD = 1e150
+"""Largest vertex coordinate and extent: products of two coordinates stay finite."""
+MIN_VOXEL = 1e-150
+"""Smallest voxel size: grid units (coordinate / voxel size) stay finite."""
 
 
 def fit_bounds(verts: np.ndarray, depth: int) -> tuple[np.ndarray, float]:
@@ -28,10 +33,17 @@ def fit_bounds(verts: np.ndarray, depth: int) -> tuple[np.ndarray, float]:
         raise Rend3rError("mesh has no vertices or non-finite coordinates")
     vmin, vmax = verts.min(0), verts.max(0)
     n = 1 << depth
-    extent = float((vmax - vmin).max()) or 1.0
-    h = extent / (n - 2.5) if n > 2 else extent
-    centre = (vmin + vmax) / 2
-    return centre - h * n / 2, h
+    with np.errstate(all="ignore"):
+        extent = float((vmax - vmin).max()) or 1.0
+        h = extent / (n - 2.5) if n > 2 else extent
+        centre = vmin / 2 + vmax / 2
+        lo = centre - h * n / 2
+    # the grid must hold every vertex with room to spare: |coordinate| and extent within
+    # MAX_COORD, and a voxel size a float resolves at that magnitude
+    if not (extent <= MAX_COORD and np.all(np.abs(verts) <= MAX_COORD) and h >= MIN_VOXEL):
+        raise Rend3rError(f"mesh coordinates must lie within +-{MAX_COORD:g} and span at least "
+                          f"{MIN_VOXEL * n:g} (extent {extent:g})")
+    return lo, h
 
 
 def _expand(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -158,8 +170,12 @@ def voxelize_surface(tri_grid: np.ndarray, n: int) -> np.ndarray:
     return _rows(np.unique(np.concatenate(keys)) if keys else np.empty(0, np.int64), n)
 
 
-def fill_solid(tri_grid: np.ndarray, n: int) -> np.ndarray:
-    """Voxels whose centre has a non-zero winding number (winding counted along +z)."""
+def fill_solid(tri_grid: np.ndarray, n: int, max_voxels: int | None = None) -> np.ndarray:
+    """Voxels whose centre has a non-zero winding number (winding counted along +z).
+
+    With ``max_voxels`` the exact count is checked before the voxels are made, and a
+    larger fill is refused with a Rend3rError.
+    """
     p = tri_grid[:, :, :2]
     lo = np.clip(np.floor(p.min(1) - 0.5).astype(np.int64), 0, n - 1)
     hi = np.clip(np.ceil(p.max(1) - 0.5).astype(np.int64), 0, n - 1)
@@ -188,14 +204,22 @@ def fill_solid(tri_grid: np.ndarray, n: int) -> np.ndarray:
     span = same_next & (wind != 0)
     k0 = np.clip(np.ceil(z[span] - 0.5).astype(np.int64), 0, n)
     k1 = np.clip(np.floor(z[np.flatnonzero(span) + 1] - 0.5).astype(np.int64), -1, n - 1)
-    run, k = _expand(np.maximum(k1 - k0 + 1, 0))
+    runs = np.maximum(k1 - k0 + 1, 0)
+    if max_voxels is not None and int(runs.sum()) > max_voxels:
+        raise Rend3rError(f"the solid fill holds {int(runs.sum()):,} voxels, over the {max_voxels:,} "
+                          "the memory budget allows (--max-memory; use a smaller --depth)")
+    run, k = _expand(runs)
     c = col[span][run]
     return np.stack([c // n, c % n, k0[run] + k], 1)
 
 
 def voxelize(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool = False,
-             ) -> tuple[np.ndarray, np.ndarray, float]:
-    """Voxelise a triangle mesh: (voxel coords (M, 3), lo corner, voxel size h)."""
+             budget: int | None = None) -> tuple[np.ndarray, np.ndarray, float]:
+    """Voxelise a triangle mesh: (voxel coords (M, 3), lo corner, voxel size h).
+
+    With ``budget`` (bytes) the build is refused up front when its estimate
+    (:mod:`rend3r.svo.budget`) exceeds it, and the solid fill again on its exact count.
+    """
     faces = np.asarray(faces, dtype=np.int64)
     if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) == 0:
         raise Rend3rError("mesh has no triangles")
@@ -204,9 +228,14 @@ def voxelize(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool = Fal
     lo, h = fit_bounds(verts, depth)
     n = 1 << depth
     tri = (np.asarray(verts, dtype=np.float64)[faces] - lo) / h
+    max_voxels = None
+    if budget is not None:
+        check_budget(estimate_voxels(tri, n, solid), budget, f"depth {depth}{' solid' if solid else ''}")
+        max_voxels = max((budget - BASE) // BYTES_PER_VOXEL, 0)
     coords = voxelize_surface(tri, n)
     if len(coords) == 0:
         raise Rend3rError("mesh has no area: every triangle has equal or collinear vertices")
     if solid:
-        coords = _unique_rows(np.concatenate([coords, fill_solid(tri, n)]), n)
+        fill = fill_solid(tri, n, None if max_voxels is None else max(max_voxels - len(coords), 0))
+        coords = _unique_rows(np.concatenate([coords, fill]), n)
     return coords, lo, h

@@ -1,0 +1,63 @@
+"""Memory budget of ``svo build``: an estimate made before voxelising, and the limit.
+
+The estimate counts voxels from the mesh itself: a surface crosses about
+``SURFACE_FACTOR`` voxels per unit of area (in voxel units: the closed-overlap test keeps
+every voxel a triangle touches), and a solid fill adds the enclosed volume (the absolute
+signed volume of the mesh, in voxels). Peak memory is ``BYTES_PER_VOXEL`` per voxel (the
+sorted keys, their coordinates and the octree builder's arrays, measured on the bundled
+models) plus a fixed ``BASE``.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+
+import numpy as np
+
+from ..errors import Rend3rError
+
+SURFACE_FACTOR = 3.0
+BYTES_PER_VOXEL = 160
+BASE = 128 << 20
+_UNITS = {"": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
+_SIZE = re.compile(r"\s*([0-9]+(?:\.[0-9]*)?)\s*([KMGT]?)(?:I?B)?\s*", re.IGNORECASE)
+
+
+def parse_bytes(text: str) -> int:
+    """``"2G"``, ``"512M"``, ``"1.5GiB"`` or a plain byte count -> bytes (ValueError otherwise)."""
+    m = _SIZE.fullmatch(text)
+    if not m:
+        raise ValueError(f"expected a size such as 2G or 512M, not {text!r}")
+    value = int(float(m[1]) * _UNITS[m[2].upper()])
+    if value <= 0:
+        raise ValueError(f"the size must be positive, not {text!r}")
+    return value
+
+
+def default_budget() -> int:
+    """Half of the machine's physical memory (4 GiB where the system does not say)."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") // 2
+    except (ValueError, OSError, AttributeError):
+        return 4 << 30
+
+
+def estimate_voxels(tri_grid: np.ndarray, n: int, solid: bool) -> int:
+    """Expected voxel count of triangles (m, 3, 3) given in voxel units of an n^3 grid."""
+    a, b, c = tri_grid[:, 0], tri_grid[:, 1], tri_grid[:, 2]
+    cross = np.cross(b - a, c - a)
+    area = 0.5 * float(np.sqrt((cross * cross).sum(1)).sum())
+    count = SURFACE_FACTOR * area
+    if solid:
+        count += abs(float((cross * a).sum())) / 6.0
+    return int(min(count, float(n) ** 3))
+
+
+def check_budget(voxels: int, budget: int, what: str) -> None:
+    """Refuse, with the estimate, a build of ``voxels`` voxels that would exceed ``budget`` bytes."""
+    need = BASE + BYTES_PER_VOXEL * voxels
+    if need > budget:
+        raise Rend3rError(f"{what}: about {voxels:,} voxels need an estimated {need / 2**30:.1f} GiB, "
+                          f"over the memory budget of {budget / 2**30:.1f} GiB (--max-memory; "
+                          "use a smaller --depth)")

@@ -17,17 +17,20 @@ from pathlib import Path
 from typing import Iterable, Mapping
 
 from ..errors import Rend3rError
+from ..fileio import read_limited
 from ..isa.extensions import EXTENSIONS
 from ..isa.tables import F_MNEMONICS, MNEMONIC_TABLE
 from ..isa.targets import TARGETS, Target
 from .diagnostics import ERROR, WARNING, Diagnostic, format_all
-from .expressions import POISON, EvalError, Value, evaluate, fold
+from .expressions import POISON, EvalError, Value, describe, evaluate, fold
 from .fastpath import fast_line
 from .operands import PAIRS, OperandEncoder
 from .parser import (
     Assignment,
+    BinOp,
     Directive,
     Instruction,
+    Neg,
     Operand,
     Ref,
     Statement,
@@ -35,11 +38,27 @@ from .parser import (
     SyntaxProblem,
     parse_instruction,
     parse_line,
+    quote,
 )
 from .program import Emitted, Program, SourceLoc
 
-#: Statements run (after .rept expansion) before the assembler gives up on a program.
+# Limits on what one run may be asked to do (docs/assembly.md, "Limits"): each bounds
+# time or memory, and reaching one is an error naming it, never a hang or a crash.
+#: Statements run after .rept expansion; an operator in a statement's operands and a
+#: line an .include reads count as one statement each.
 MAX_STATEMENTS = 1 << 20
+#: Bytes of one source file (the main file or an included one).
+MAX_SOURCE = 32 << 20
+#: Lines and bytes read in one run, counting every file each time it is (re)read.
+MAX_LINES = 1 << 22
+MAX_READ = 64 << 20
+#: Characters of one line.
+MAX_LINE = 16_384
+#: Nesting of .include and of .rept blocks (each level is a level of recursion).
+MAX_INCLUDE_DEPTH = 32
+MAX_REPT_DEPTH = 64
+#: Errors after which the CLI stops (``--max-errors``; 0 = no limit).
+MAX_ERRORS = 20
 WORD_LIMIT = 1 << 32
 
 MNEMONICS = (*F_MNEMONICS, *MNEMONIC_TABLE)
@@ -57,6 +76,7 @@ class AssemblyResult:
     program: Program
     diagnostics: list[Diagnostic] = field(default_factory=list)
     mnemonics_used: set[str] = field(default_factory=set)
+    stopped_at: int = 0  # the max_errors limit the run stopped at (0: it ran to its end)
 
     @property
     def ok(self) -> bool:
@@ -72,8 +92,12 @@ class AssemblyResult:
         return [d for d in self.diagnostics if not d.is_error]
 
     def format_diagnostics(self) -> str:
-        """Every diagnostic with its source line and caret, then a summary line."""
-        return format_all(self.diagnostics)
+        """Every diagnostic with its source line and caret, then a summary line (and a
+        line saying the run stopped, when it reached its error limit)."""
+        text = format_all(self.diagnostics)
+        if self.stopped_at:
+            text += f"\nstopped after {self.stopped_at} errors (the limit; --max-errors 0 for none)"
+        return text
 
 
 def resolve_isa_ext(isa_ext: IsaExt) -> frozenset[str]:
@@ -86,7 +110,7 @@ def resolve_isa_ext(isa_ext: IsaExt) -> frozenset[str]:
 
 
 class _Abort(Exception):
-    """Stop assembling (the program is too large to expand)."""
+    """Stop assembling (a limit was reached; its error is reported already)."""
 
 
 @dataclass
@@ -95,6 +119,7 @@ class _Stmt:
     file: str
     line: int
     text: str
+    cost: int = 1  # statements it counts as: one, plus one per operator in its operands
 
 
 @dataclass
@@ -114,6 +139,22 @@ class _Rept:
     line: int
     text: str
     body: list = field(default_factory=list)
+
+
+def _operators(stmt: Statement) -> int:
+    """The operators in a statement's operands (counted without recursion)."""
+    todo = list(stmt.operands if isinstance(stmt, Instruction) else
+                (stmt.expr,) if isinstance(stmt, Assignment) else stmt.args)
+    count = 0
+    while todo:
+        node = todo.pop()
+        if isinstance(node, Neg):
+            count += 1
+            todo.append(node.operand)
+        elif isinstance(node, BinOp):
+            count += 1
+            todo += (node.left, node.right)
+    return count
 
 
 def _folded(stmt: Statement) -> Statement:
@@ -139,7 +180,7 @@ class Assembler:
     """One assembler run; use :func:`assemble_source` or :func:`assemble_file`."""
 
     def __init__(self, include_paths: Iterable[str | os.PathLike[str]] = (), target: str | Target | None = None,
-                 fast: bool = True, isa_ext: IsaExt = ()) -> None:
+                 fast: bool = True, isa_ext: IsaExt = (), max_errors: int = 0, werror: bool = False) -> None:
         self.include_paths = [Path(p) for p in include_paths]
         self.target = resolve_target(target)
         self.limits = (
@@ -155,7 +196,17 @@ class Assembler:
         self.defined_at: dict[str, str] = {}
         self.scopes: list[list[str]] = []  # constants defined in each running .rept iteration
         self.include_stack: list[Path] = []
+        # (including file, name) -> path, resolved path, text (None: not found or not read)
+        self.includes: dict[tuple[str, str], tuple[Path, Path, str] | None] = {}
+        self.include_depth = 0
         self.statements = 0
+        self.lines_read = 0
+        self.bytes_read = 0
+        self.rept_depth = 0  # .rept blocks running
+        self.max_errors = max_errors
+        self.errors_counted = {ERROR, WARNING} if werror else {ERROR}  # what max_errors counts
+        self.error_count = 0
+        self.stopped_at = 0
         # where the statement being run comes from: file, line, text, context
         self.where: tuple[str, int, str, tuple[str, ...]] = ("", 0, "", ())
         self.mnemonic_names: tuple[str, ...] = MNEMONICS  # the base ones and those of enabled extensions
@@ -180,6 +231,11 @@ class Assembler:
             return  # the same problem on every .rept iteration is reported once
         self._seen.add(key)
         self.diagnostics.append(Diagnostic(severity, message, file, line, col, end, text, context))
+        if severity in self.errors_counted:
+            self.error_count += 1
+            if self.error_count == self.max_errors:
+                self.stopped_at = self.max_errors
+                raise _Abort
 
     def error(self, message: str, col: int = 1, end: int = 0) -> None:
         self.report(ERROR, message, col, end)
@@ -188,6 +244,17 @@ class Assembler:
         self.report(WARNING, message, col, end)
 
     # -- reading -----------------------------------------------------------------------
+
+    def count_read(self, text: str, cost: int) -> None:
+        """Charge the reading of ``text`` to the run's budgets (``cost`` statements
+        besides): beyond a limit, an error here and the run stops."""
+        self.lines_read += text.count("\n") + 1
+        self.bytes_read += len(text)
+        if self.lines_read > MAX_LINES or self.bytes_read > MAX_READ:
+            self.error(f"sources too large: more than {MAX_LINES:,} lines or {MAX_READ:,} bytes read in all "
+                       "(an .include in a .rept reads its file again each time)")
+            raise _Abort
+        self.count_statement(cost)
 
     def run_text(self, text: str, file: str, context: tuple[str, ...] = ()) -> None:
         """Read and run ``text`` as the lines of ``file``."""
@@ -199,6 +266,10 @@ class Assembler:
         if "\r" in text:
             text = text.replace("\r\n", "\n")
         for lineno, line in enumerate(text.split("\n"), 1):
+            if len(line) > MAX_LINE:
+                self.where = (file, lineno, line, context)
+                self.error(f"line is {len(line):,} characters long; the limit is {MAX_LINE:,}", MAX_LINE + 1)
+                continue
             hit = fast_line(line, limits) if fast else None
             if hit is not None:
                 if not hit:
@@ -230,6 +301,9 @@ class Assembler:
                 continue
             kind = stmt.name.lower() if isinstance(stmt, Directive) else ""
             if kind == ".rept":
+                if len(open_repts) + self.rept_depth >= MAX_REPT_DEPTH:
+                    self.error(f".rept blocks nested too deeply (more than {MAX_REPT_DEPTH} levels)", stmt.col, stmt.end)
+                    raise _Abort
                 node = _Rept(stmt, file, lineno, line)
                 if body is not None:
                     body.append(node)
@@ -248,22 +322,23 @@ class Assembler:
                     body = None
                     self.run_rept(done, context)
             elif body is not None:
-                body.append(_Stmt(_folded(stmt), file, lineno, line))
+                body.append(_Stmt(_folded(stmt), file, lineno, line, 1 + _operators(stmt)))
             else:
-                self.run_statement(_Stmt(stmt, file, lineno, line), context)
+                self.run_statement(_Stmt(stmt, file, lineno, line, 1 + _operators(stmt)), context)
         for node in open_repts:
             self.where = (node.file, node.line, node.text, context)
             self.error(".rept without a matching .endr", node.stmt.col, node.stmt.end)
 
-    def count_statement(self) -> None:
-        self.statements += 1
+    def count_statement(self, cost: int = 1) -> None:
+        self.statements += cost
         if self.statements > MAX_STATEMENTS:
             self.too_large()
 
     def too_large(self) -> None:
         file, line, _, _ = self.where
         self.where = (file, line, "", ())
-        self.error(f"program too large: more than {MAX_STATEMENTS} statements after .rept expansion")
+        self.error(f"program too large: more than {MAX_STATEMENTS:,} statements after .rept expansion "
+                   "(an operator or a line read by .include counts as one)")
         raise _Abort
 
     # -- running -----------------------------------------------------------------------
@@ -309,21 +384,25 @@ class Assembler:
         var = self.new_name(args[1], "a .rept variable") if len(args) == 2 else None
         if count is None or (len(args) == 2 and var is None):
             return
-        for i in range(count):
-            label = f"{var}={i}" if var else f"#{i}"
-            inner = (f"in .rept iteration {label} ({node.file}:{node.line})", *context)
-            self.scopes.append([])
-            if var:
-                self.define(var, Value(i), f"{node.file}:{node.line}")
-            for item in node.body:
-                self.run_item(item, inner)
-            for name in self.scopes.pop():
-                del self.env[name]
-                del self.defined_at[name]
+        self.rept_depth += 1
+        try:
+            for i in range(count):
+                label = f"{var}={i}" if var else f"#{i}"
+                inner = (f"in .rept iteration {label} ({node.file}:{node.line})", *context)
+                self.scopes.append([])
+                if var:
+                    self.define(var, Value(i), f"{node.file}:{node.line}")
+                for item in node.body:
+                    self.run_item(item, inner)
+                for name in self.scopes.pop():
+                    del self.env[name]
+                    del self.defined_at[name]
+        finally:
+            self.rept_depth -= 1
 
     def run_statement(self, item: _Stmt, context: tuple[str, ...]) -> None:
         self.where = (item.file, item.line, item.text, context)
-        self.count_statement()
+        self.count_statement(item.cost)
         stmt = item.stmt
         if isinstance(stmt, Instruction):
             words = self.operands.instruction(stmt)
@@ -389,15 +468,16 @@ class Assembler:
             self.error(f"{what} must be an integer, not raw bits '{src}'", node.col, node.end)
             return None
         if not v.is_integer:
-            self.error(f"{what} must be an integer, got {src} = {float(v.number):g}", node.col, node.end)
+            self.error(f"{what} must be an integer, got {src} = {describe(v.number)}", node.col, node.end)
             return None
         if not lo <= v.number < limit:
-            self.error(f"{what} {v.number} is out of range ({lo}..{limit - 1})", node.col, node.end)
+            self.error(f"{what} {describe(v.number)} is out of range ({lo}..{limit - 1})", node.col, node.end)
             return None
         return v.number
 
     def source(self, node: Operand) -> str:
-        return self.where[2][node.col - 1 : node.end - 1]
+        """The operand's text as written, cut for a message (see :func:`.parser.quote`)."""
+        return quote(self.where[2][node.col - 1 : node.end - 1])
 
     # -- directives --------------------------------------------------------------------
 
@@ -439,26 +519,48 @@ class Assembler:
             self.error(f"unknown ISA extension '{arg.name}'{hint}", arg.col, arg.end)
 
     def include(self, arg: Str, item: _Stmt, context: tuple[str, ...]) -> None:
-        base = Path(item.file).parent
-        candidates = [base / arg.text, *(d / arg.text for d in self.include_paths)]
-        path = next((p for p in candidates if p.is_file()), None)
-        if path is None:
-            searched = ", ".join(str(p.parent) for p in candidates)
-            self.error(f"cannot find include file '{arg.text}' (searched: {searched})", arg.col, arg.end)
+        if self.include_depth >= MAX_INCLUDE_DEPTH:
+            self.error(f".include nested too deeply (more than {MAX_INCLUDE_DEPTH} levels)", arg.col, arg.end)
             return
-        real = path.resolve()
+        key = (item.file, arg.text)
+        if key not in self.includes:  # found once per run: a .rept does not search again
+            self.includes[key] = self.find_include(arg, item)
+        found = self.includes[key]
+        if found is None:
+            return
+        path, real, text = found
         if real in self.include_stack:
             chain = " -> ".join(p.name for p in [*self.include_stack[self.include_stack.index(real):], real])
             self.error(f"include cycle: {chain}", arg.col, arg.end)
             return
-        text = read_source(path, self.error_at(arg))
-        if text is None:
-            return
+        self.count_read(text, text.count("\n") + 1)
         self.include_stack.append(real)
+        self.include_depth += 1
         try:
             self.run_text(text, str(path), (f"included from {item.file}:{item.line}", *context))
         finally:
             self.include_stack.pop()
+            self.include_depth -= 1
+
+    def find_include(self, arg: Str, item: _Stmt) -> tuple[Path, Path, str] | None:
+        """The path, resolved path and text of an included file, or None after an error."""
+        base = Path(item.file).parent
+        candidates = [base / arg.text, *(d / arg.text for d in self.include_paths)]
+        problem = ""
+        for candidate in candidates:
+            try:
+                if candidate.is_file():
+                    real = candidate.resolve()
+                    break
+            except (OSError, RuntimeError) as exc:  # a name too long, a symlink loop
+                problem = problem or f": {getattr(exc, 'strerror', None) or exc}"
+        else:
+            searched = ", ".join(str(p.parent) for p in candidates)
+            self.error(f"cannot find include file '{quote(arg.text)}'{problem} (searched: {quote(searched)})",
+                       arg.col, arg.end)
+            return None
+        text = read_source(candidate, self.error_at(arg))
+        return None if text is None else (candidate, real, text)
 
     def error_at(self, node: Operand):
         return lambda message: self.error(message, node.col, node.end)
@@ -481,11 +583,11 @@ class Assembler:
 
 
 def read_source(path: Path, error) -> str | None:
-    """A source file's text, or None after calling ``error(message)``."""
+    """A source file's text (at most MAX_SOURCE bytes), or None after calling ``error(message)``."""
     try:
-        data = path.read_bytes()
-    except OSError as exc:
-        error(f"cannot read '{path}': {exc.strerror or exc}")
+        data = read_limited(path, MAX_SOURCE, what="source")
+    except Rend3rError as exc:
+        error(str(exc))
         return None
     try:
         return data.decode("utf-8-sig")
@@ -496,7 +598,7 @@ def read_source(path: Path, error) -> str | None:
 
 def _result(asm: Assembler, werror: bool) -> AssemblyResult:
     diagnostics = [d.as_error() for d in asm.diagnostics] if werror else asm.diagnostics
-    return AssemblyResult(Program(asm.entries), diagnostics, asm.mnemonics)
+    return AssemblyResult(Program(asm.entries), diagnostics, asm.mnemonics, asm.stopped_at)
 
 
 def assemble_source(
@@ -508,17 +610,21 @@ def assemble_source(
     werror: bool = False,
     fast: bool = True,
     isa_ext: IsaExt = (),
+    max_errors: int = 0,
 ) -> AssemblyResult:
     """Assemble source text. ``.include`` paths are relative to ``filename``'s directory
     (the current directory for ``<input>``), then to each of ``include_paths``.
     ``isa_ext`` names ISA extensions to enable from the start (``"hybrid"``, or several;
     a source can also enable them with ``.isa_ext``). ``fast=False`` parses every line
-    with the full grammar (for testing the fast path).
+    with the full grammar (for testing the fast path). ``max_errors`` stops the run at
+    that many errors (0: no limit; the result's ``stopped_at`` says it stopped).
     """
-    asm = Assembler(include_paths, target, fast, isa_ext)
-    if filename != "<input>":
-        asm.include_stack.append(Path(filename).resolve())
+    asm = Assembler(include_paths, target, fast, isa_ext, max_errors, werror)
     try:
+        if filename != "<input>":
+            asm.include_stack.append(Path(filename).resolve())
+        asm.where = (filename, 0, "", ())
+        asm.count_read(text, 0)
         asm.run_text(text, filename)
     except _Abort:
         pass
@@ -534,14 +640,16 @@ def assemble_file(
     *,
     werror: bool = False,
     isa_ext: IsaExt = (),
+    max_errors: int = 0,
 ) -> AssemblyResult:
-    """Assemble a source file; a missing or unreadable file is an error diagnostic."""
+    """Assemble a source file; a missing or unreadable file (or one over MAX_SOURCE
+    bytes) is an error diagnostic."""
     asm = Assembler(include_paths, target, isa_ext=isa_ext)
     name = str(path)
     text = read_source(Path(path), lambda message: asm.diagnostics.append(Diagnostic(ERROR, message, name, 0)))
     if text is None:
         return _result(asm, werror)
-    return assemble_source(text, name, include_paths, target, werror=werror, isa_ext=isa_ext)
+    return assemble_source(text, name, include_paths, target, werror=werror, isa_ext=isa_ext, max_errors=max_errors)
 
 
 def assemble_or_raise(
@@ -550,9 +658,11 @@ def assemble_or_raise(
     target: str | Target | None = None,
     *,
     isa_ext: IsaExt = (),
+    max_errors: int = MAX_ERRORS,
 ) -> AssemblyResult:
-    """Assemble a file, raising :class:`Rend3rError` with every diagnostic on errors."""
-    result = assemble_file(path, include_paths, target, isa_ext=isa_ext)
+    """Assemble a file, raising :class:`Rend3rError` with every diagnostic on errors
+    (the first ``max_errors`` of them; 0 for all)."""
+    result = assemble_file(path, include_paths, target, isa_ext=isa_ext, max_errors=max_errors)
     if not result.ok:
         raise Rend3rError(result.format_diagnostics(), preformatted=True)
     return result

@@ -63,8 +63,11 @@ Examples:
                    "A source can say .isa_ext NAME instead.")
 @click.option("-W", "warn", type=click.Choice(["error"]), help="-W error: treat warnings as errors.")
 @click.option("--werror", is_flag=True, help="Treat warnings as errors (same as -W error).")
+@click.option("--max-errors", type=click.IntRange(min=0), default=20, show_default=True, metavar="N",
+              help="Stop after N errors (0: report every error).")
 def asm_command(src: Path, out: str | None, formats: tuple[str, ...], include_dirs: tuple[str, ...],
-                target: str | None, isa_ext: tuple[str, ...], byteorder: str, warn: str | None, werror: bool) -> None:
+                target: str | None, isa_ext: tuple[str, ...], byteorder: str, warn: str | None, werror: bool,
+                max_errors: int) -> None:
     """Assemble SRC (a .asm file) into memory images for the REND3R device.
 
     Diagnostics go to standard error. On any error the exit status is 1 and no output
@@ -79,7 +82,8 @@ def asm_command(src: Path, out: str | None, formats: tuple[str, ...], include_di
     for fmt, path in paths.items():
         if path is None and FORMATS[fmt].binary and sys.stdout.isatty():
             raise Rend3rError(f"{fmt} output is binary: give -o FILE (or redirect standard output)")
-    result = assemble_file(src, include_dirs, target, werror=werror or warn == "error", isa_ext=isa_ext)
+    result = assemble_file(src, include_dirs, target, werror=werror or warn == "error", isa_ext=isa_ext,
+                           max_errors=max_errors)
     if result.diagnostics:
         click.echo(result.format_diagnostics(), err=True)
     if not result.ok:

@@ -6,6 +6,9 @@ from dataclasses import dataclass
 
 ERROR = "error"
 WARNING = "warning"
+#: Longest source line shown whole under a diagnostic; a longer one is shown as a window
+#: of this many characters around the span.
+SHOWN_LINE = 160
 
 
 @dataclass(frozen=True)
@@ -41,10 +44,24 @@ class Diagnostic:
         where = f"{self.file}:{self.line}:{self.col}" if self.line else self.file
         out = [f"{where}: {self.severity}: {self.message}"]
         if self.text.strip():
-            out.append("    " + self.text)
-            out.append("    " + caret_line(self.text, self.col, self.end))
+            text, col, end = window(self.text, self.col, self.end)
+            out.append("    " + text)
+            out.append("    " + caret_line(text, col, end))
         out.extend(f"    {c}" for c in self.context)
         return "\n".join(out)
+
+
+def window(text: str, col: int, end: int) -> tuple[str, int, int]:
+    """At most about SHOWN_LINE characters of ``text`` around columns [col, end), with
+    ``...`` where it was cut, and the span's columns in the result."""
+    if len(text) <= SHOWN_LINE:
+        return text, col, end
+    start = max(min(col - 1 - SHOWN_LINE // 4, len(text) - SHOWN_LINE), 0)
+    stop = start + SHOWN_LINE
+    head = "..." if start else ""
+    shown = head + text[start:stop] + ("..." if stop < len(text) else "")
+    shift = len(head) - start
+    return shown, col + shift, min(end, stop + 1) + shift
 
 
 def caret_line(text: str, col: int, end: int) -> str:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Mapping
 
-from .parser import BinOp, Expr, Neg, Num, Operand, Ref, Str
+from .parser import MAX_BITS, BinOp, Expr, Neg, Num, Operand, Ref, Str
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,6 +98,13 @@ def _binop(node: BinOp, a: Value, b: Value) -> Value:
         r = q if rem == 0 else Fraction(x, y)
     else:
         r = x / y
+    if type(r) is int:
+        too_large = r.bit_length() > MAX_BITS
+    else:
+        too_large = max(r.numerator.bit_length(), r.denominator.bit_length()) > MAX_BITS
+    if too_large:
+        raise EvalError(f"result out of range: exact arithmetic is limited to {MAX_BITS:,}-bit numerators and "
+                        f"denominators (about 10^4000)", node.col, node.end)
     if r:
         return Value(r.numerator if type(r) is Fraction and r.denominator == 1 else r)
     # An exact zero: its sign as IEEE 754 gives it. A sum is -0 only when both addends
@@ -108,6 +115,20 @@ def _binop(node: BinOp, a: Value, b: Value) -> Value:
     return Value(0, negative_zero=a.sign_negative != b.sign_negative)
 
 
+def describe(number: int | Fraction) -> str:
+    """``number`` for a message: exact when short, else its magnitude (``about 1.2e+4000``)."""
+    if type(number) is int:
+        text = str(abs(number))  # at most MAX_BITS bits: within Python's int->str limit
+        if len(text) <= 24:
+            return str(number)
+        sign = "-" if number < 0 else ""
+        return f"about {sign}{text[0]}.{text[1:4]}e+{len(text) - 1}"
+    try:
+        return f"{float(number):g}"
+    except OverflowError:
+        return describe(int(number))
+
+
 def fold(node: Operand) -> Operand:
     """``node`` with every arithmetic on literals done once, ahead of time (used for
     ``.rept`` bodies, which run many times). Whatever would fail is left as written, so
@@ -115,13 +136,13 @@ def fold(node: Operand) -> Operand:
     cls = type(node)
     if cls is Neg:
         inner = fold(node.operand)
-        node = Neg(inner, node.col, node.end)
+        node = Neg(inner, node.col, node.end, node.depth)
         if _foldable(inner):
             v = evaluate(node, {})
             return Num(v.number, "dec", node.col, node.end, negative_zero=v.negative_zero)
         return node
     if cls is BinOp:
-        node = BinOp(node.op, fold(node.left), fold(node.right), node.col, node.end)
+        node = BinOp(node.op, fold(node.left), fold(node.right), node.col, node.end, node.depth)
         if _foldable(node.left) and _foldable(node.right):
             try:
                 v = evaluate(node, {})

@@ -28,7 +28,7 @@ from ..isa.tables import (
     lookup,
 )
 from ..isa.targets import Target
-from .expressions import Value
+from .expressions import Value, describe
 from .parser import Instruction, Operand, Ref
 
 _EXTENSION_OF = {m: name for name, ms in EXTENSIONS.items() for m in ms}
@@ -203,7 +203,7 @@ class OperandEncoder:
             host.error(f"{what} takes an integer or 0h raw bits, got {src}", node.col, node.end)
             return None
         if not 0 <= v.number < (1 << bits):
-            shown = src if src == str(v.number) else f"{src} = {v.number}"
+            shown = src if src == describe(v.number) else f"{src} = {describe(v.number)}"
             host.error(
                 f"{shown} is out of range for {what} ({bits} bits: 0..{(1 << bits) - 1})",
                 node.col,
@@ -216,7 +216,7 @@ class OperandEncoder:
         host = self.host
         if v.hex_literal:
             host.warning(
-                f"{src} is the integer {v.number} for float16 property '{prop.name}'; "
+                f"{src} is the integer {describe(v.number)} for float16 property '{prop.name}'; "
                 f"write 0h{src[2:].replace('_', '').lower()} for raw bits",
                 node.col,
                 node.end,

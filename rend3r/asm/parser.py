@@ -21,6 +21,15 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedToken
 #: arithmetic can be asked to do (1e4000 is already far beyond float16).
 MAX_EXPONENT = 4000
 MAX_DIGITS = 1000
+#: Largest numerator and denominator exact arithmetic may hold, in bits: a little above
+#: the literals' own range (10^4000 is 13,288 bits), far beyond float16 (17 bits) and a
+#: 32-bit word, and small enough that every operation and printing stays quick.
+MAX_BITS = 13_300
+#: Deepest expression tree accepted (operators nested in operators, e.g. a 201-term sum
+#: or 201 unary minus signs): evaluation recurses once per level.
+MAX_DEPTH = 200
+#: Longest piece of source quoted in a message.
+QUOTE_LIMIT = 40
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,6 +59,7 @@ class Neg:
     operand: "Expr"
     col: int
     end: int
+    depth: int = 1  # levels of operators in this tree (bounded by MAX_DEPTH)
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,6 +69,7 @@ class BinOp:
     right: "Expr"
     col: int
     end: int
+    depth: int = 1
 
 
 @dataclass(frozen=True, slots=True)
@@ -111,6 +122,16 @@ class SyntaxProblem(Exception):
         self.end = end
 
 
+def quote(text: str) -> str:
+    """``text`` for a message: cut to :data:`QUOTE_LIMIT` characters with ``...``."""
+    return text if len(text) <= QUOTE_LIMIT else text[: QUOTE_LIMIT - 3] + "..."
+
+
+def depth(node: object) -> int:
+    """Levels of operators in an expression tree (0 for a literal or a name)."""
+    return node.depth if type(node) in (Neg, BinOp) else 0
+
+
 _DEC = re.compile(r"(?:\d+(?:_\d+)*)?(?:\.(?:\d+(?:_\d+)*)?)?(?:[eE][+-]?\d+(?:_\d+)*)?")
 _DIGITS = {"HEX": ("0123456789abcdefABCDEF", 16), "BIN": ("01", 2), "RAW": ("0123456789abcdefABCDEF", 16)}
 _KIND = {"NUMBER": "dec", "HEX": "hex", "BIN": "bin", "RAW": "raw"}
@@ -124,13 +145,17 @@ def parse_number(text: str, token_type: str) -> tuple[int | Fraction, str]:
     """
     if token_type == "NUMBER":
         if not _DEC.fullmatch(text) or not any(c.isdigit() for c in text.split("e")[0].split("E")[0]):
-            return 0, f"malformed number '{text}'"
+            return 0, f"malformed number '{quote(text)}'"
         mantissa, _, exponent = text.replace("_", "").lower().partition("e")
-        if exponent and abs(int(exponent)) > MAX_EXPONENT:
-            return 0, f"exponent of '{text}' is out of range (at most {MAX_EXPONENT} in magnitude)"
+        magnitude = exponent.lstrip("+-").lstrip("0") or "0"
+        if len(magnitude) > 5 or int(magnitude) > MAX_EXPONENT:
+            return 0, f"exponent of '{quote(text)}' is out of range (at most {MAX_EXPONENT} in magnitude)"
         if len(mantissa) > MAX_DIGITS:
             return 0, f"number '{text[:20]}...' has too many digits (at most {MAX_DIGITS})"
-        value = Fraction(mantissa + ("e" + exponent if exponent else ""))
+        sign = "-" if exponent.startswith("-") else ""
+        value = Fraction(mantissa + ("e" + sign + magnitude if exponent else ""))
+        if max(value.numerator.bit_length(), value.denominator.bit_length()) > MAX_BITS:
+            return 0, f"number '{quote(text)}' is out of range (exact values are limited to {MAX_BITS:,} bits)"
         return (value.numerator if value.denominator == 1 else value), ""
     digits, base = _DIGITS[token_type]
     body = text[2:]
@@ -138,12 +163,12 @@ def parse_number(text: str, token_type: str) -> tuple[int | Fraction, str]:
     if not body or body.startswith("_") or body.endswith("_") or "__" in body or any(
         c not in digits and c != "_" for c in body
     ):
-        return 0, f"malformed {name} number '{text}'"
+        return 0, f"malformed {name} number '{quote(text)}'"
     body = body.replace("_", "")
     if len(body) > MAX_DIGITS:
         return 0, f"number '{text[:20]}...' has too many digits (at most {MAX_DIGITS})"
     if token_type == "RAW" and len(body) > 4:
-        return 0, f"raw bits '{text}' have more than 4 hex digits (16 bits)"
+        return 0, f"raw bits '{quote(text)}' have more than 4 hex digits (16 bits)"
     return int(body, base), ""
 
 
@@ -182,7 +207,7 @@ class _Builder(Transformer):
 
     def neg(self, children: list) -> Neg:
         sign, operand = children
-        return Neg(operand, sign.column, operand.end)
+        return Neg(operand, sign.column, operand.end, _deeper(operand, sign.column, operand.end))
 
     def pos(self, children: list) -> Expr:
         sign, operand = children
@@ -194,7 +219,16 @@ class _Builder(Transformer):
 
     def binop(self, children: list) -> BinOp:
         left, op, right = children
-        return BinOp(str(op), left, right, left.col, right.end)
+        level = _deeper(left if depth(left) >= depth(right) else right, left.col, right.end)
+        return BinOp(str(op), left, right, left.col, right.end, level)
+
+
+def _deeper(child: Expr, col: int, end: int) -> int:
+    """The depth of an operator over ``child``; beyond MAX_DEPTH a SyntaxProblem."""
+    level = depth(child) + 1
+    if level > MAX_DEPTH:
+        raise SyntaxProblem(f"expression nested too deeply (more than {MAX_DEPTH} levels of operators)", col, end)
+    return level
 
 
 def _respan(node: Expr, col: int, end: int) -> Expr:
@@ -259,15 +293,16 @@ def parse_line(text: str) -> Statement | None:
         if tok.type == "$END":
             col = len(text.split(";")[0].split("//")[0].rstrip()) + 1
             raise SyntaxProblem(f"unexpected end of line, expected {expected}", col, col + 1) from None
-        what = f"'{tok}'"
+        what = f"'{quote(str(tok))}'"
         raise SyntaxProblem(f"unexpected {what}, expected {expected}", tok.column, tok.end_column) from None
 
 
 _WS = "[ \t\f\v\r]"
-# mnemonic, whitespace, operand text (no string, no comment), optional comment
-_INSTRUCTION = re.compile(
-    rf"{_WS}*([A-Za-z_][A-Za-z0-9_]*){_WS}+((?:[^;/\"]|/(?!/))*?){_WS}*(?:(?://|;).*)?", re.ASCII
-)
+# mnemonic, whitespace, operand text (no string, no comment; trailing whitespace is
+# stripped afterwards), optional comment. The operand group is greedy and ends where a
+# comment can start, so a failed match backtracks once over the line, not once per
+# character (a lazy group followed by whitespace was quadratic in the line length).
+_INSTRUCTION = re.compile(rf"{_WS}*([A-Za-z_][A-Za-z0-9_]*){_WS}+((?:[^;/\"]|/(?!/))*)(?:(?://|;).*)?", re.ASCII)
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*", re.ASCII)
 #: operand text -> its tree with columns counted from the operand's first character
 _OPERANDS: dict[str, Expr | None] = {}
@@ -288,7 +323,7 @@ def parse_instruction(text: str) -> Instruction | None:
     tree :func:`parse_line` builds for the same line.
     """
     m = _INSTRUCTION.fullmatch(text)
-    if m is None or not m.group(2):
+    if m is None or not m.group(2).strip(" \t\f\v\r"):
         return None
     operands = []
     pos = m.start(2)
@@ -305,7 +340,7 @@ def parse_instruction(text: str) -> Instruction | None:
         if node is False:
             try:
                 node = _parser().parse(stripped, start="operand")
-            except (UnexpectedCharacters, UnexpectedToken):
+            except (UnexpectedCharacters, UnexpectedToken, SyntaxProblem):
                 node = None
             if len(_OPERANDS) >= _OPERAND_CACHE_LIMIT:
                 _OPERANDS.clear()
@@ -326,5 +361,6 @@ def _shift(node: Expr, delta: int) -> Expr:
     if cls is Ref:
         return Ref(node.name, node.col + delta, node.end + delta)
     if cls is Neg:
-        return Neg(_shift(node.operand, delta), node.col + delta, node.end + delta)
-    return BinOp(node.op, _shift(node.left, delta), _shift(node.right, delta), node.col + delta, node.end + delta)
+        return Neg(_shift(node.operand, delta), node.col + delta, node.end + delta, node.depth)
+    return BinOp(node.op, _shift(node.left, delta), _shift(node.right, delta), node.col + delta, node.end + delta,
+                 node.depth)

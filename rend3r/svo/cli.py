@@ -89,7 +89,7 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
     """
     import numpy as np
 
-    from .budget import check_budget, default_budget
+    from .budget import check_budget, default_budget, max_voxels
     from .fileformat import SvoModel, encode_svo
     from .mesh_io import encode_binvox, read_binvox, read_mesh
     from .octree import build_octree
@@ -100,7 +100,7 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
 
     start = time.perf_counter()
     if Path(mesh).suffix.lower() == ".binvox":
-        coords, dim, translate, scale = read_binvox(mesh)
+        coords, dim, translate, scale = read_binvox(mesh, max_voxels(budget))
         need = max(int(np.ceil(np.log2(dim))), 1)
         if depth is not None and depth != need:
             raise Rend3rError(f"{mesh}: a {dim}^3 binvox grid needs --depth {need}")

@@ -296,8 +296,13 @@ def encode_binvox(coords: np.ndarray, dim: int, translate=(0.0, 0.0, 0.0), scale
     return header + np.stack([v, counts], 1).astype(np.uint8).tobytes()
 
 
-def decode_binvox(data: bytes, name: str = "<binvox>") -> tuple[np.ndarray, int, np.ndarray, float]:
-    """Sparse voxels of a binvox file: (coords (k, 3), dim, translate, scale)."""
+def decode_binvox(data: bytes, name: str = "<binvox>", max_voxels: int | None = None,
+                  ) -> tuple[np.ndarray, int, np.ndarray, float]:
+    """Sparse voxels of a binvox file: (coords (k, 3), dim, translate, scale).
+
+    With ``max_voxels`` a file holding more solid voxels is refused before they are made
+    (a few bytes of runs can stand for billions of voxels).
+    """
     pos = data.find(b"data\n")
     if not data.startswith(b"#binvox") or pos < 0:
         raise Rend3rError(f"{name}: not a binvox file")
@@ -321,6 +326,10 @@ def decode_binvox(data: bytes, name: str = "<binvox>") -> tuple[np.ndarray, int,
         raise Rend3rError(f"{name}: binvox data holds {counts.sum()} voxels, expected {dim ** 3}")
     starts = np.cumsum(counts) - counts
     on = values != 0
+    solid = int(counts[on].sum())
+    if max_voxels is not None and solid > max_voxels:
+        raise Rend3rError(f"{name}: {solid:,} solid voxels, over the {max_voxels:,} the memory budget "
+                          "allows (--max-memory)")
     run = np.repeat(np.flatnonzero(on), counts[on])
     offs = np.arange(len(run)) - (np.cumsum(counts[on]) - counts[on]).repeat(counts[on])
     idx = starts[run] + offs
@@ -329,11 +338,11 @@ def decode_binvox(data: bytes, name: str = "<binvox>") -> tuple[np.ndarray, int,
     return coords, dim, translate, scale
 
 
-def read_binvox(path: str | os.PathLike[str]):
-    """Sparse voxels of a binvox file (at most :data:`MAX_MESH` bytes)."""
+def read_binvox(path: str | os.PathLike[str], max_voxels: int | None = None):
+    """Sparse voxels of a binvox file (at most :data:`MAX_MESH` bytes; see :func:`decode_binvox`)."""
     data = read_limited(path, MAX_MESH, what="binvox file")
     try:
-        return decode_binvox(data, str(path))
+        return decode_binvox(data, str(path), max_voxels)
     except (IndexError, ValueError, OverflowError) as exc:
         raise Rend3rError(f"{path}: malformed binvox file: {exc}") from None
 

@@ -17,7 +17,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import Rend3rError
-from .budget import BASE, BYTES_PER_VOXEL, check_budget, estimate_voxels
+from .budget import check_budget, estimate_voxels
+from .budget import max_voxels as voxel_limit
 
 _CHUNK = 1 << 19  # candidate (triangle, voxel) pairs per vectorised batch
 MAX_COORD = 1e150
@@ -156,17 +157,28 @@ def _split_large(tri: np.ndarray, n: int) -> np.ndarray:
     return np.concatenate(done)
 
 
-def voxelize_surface(tri_grid: np.ndarray, n: int) -> np.ndarray:
+def voxelize_surface(tri_grid: np.ndarray, n: int, max_voxels: int | None = None) -> np.ndarray:
     """Unique voxels (M, 3) overlapped by triangles given in grid units (voxel i = [i, i+1]).
 
     Degenerate triangles (equal or collinear vertices: zero area) cover no surface and
-    are skipped; M is 0 when every triangle is degenerate.
+    are skipped; M is 0 when every triangle is degenerate. With ``max_voxels``, more
+    voxels than that are refused with a Rend3rError as soon as the batches hold them.
     """
     tri_grid = tri_grid[np.any(np.cross(tri_grid[:, 1] - tri_grid[:, 0], tri_grid[:, 2] - tri_grid[:, 0]), axis=1)]
     tri_grid = _split_large(tri_grid, n)
     weight = _weight(tri_grid, n)
     # batches keep only their unique keys (8 bytes a voxel) until the final merge
-    keys = [_keys(_surface_chunk(tri_grid[s], n), n) for s in _batches(weight, _CHUNK)]
+    keys: list[np.ndarray] = []
+    held = 0
+    for s in _batches(weight, _CHUNK):
+        keys.append(_keys(_surface_chunk(tri_grid[s], n), n))
+        held += len(keys[-1])
+        if max_voxels is not None and held > max_voxels:
+            keys = [np.unique(np.concatenate(keys))]
+            held = len(keys[0])
+            if held > max_voxels:
+                raise Rend3rError(f"the surface holds more than {max_voxels:,} voxels, the most the memory "
+                                  "budget allows (--max-memory; use a smaller --depth)")
     return _rows(np.unique(np.concatenate(keys)) if keys else np.empty(0, np.int64), n)
 
 
@@ -228,14 +240,14 @@ def voxelize(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool = Fal
     lo, h = fit_bounds(verts, depth)
     n = 1 << depth
     tri = (np.asarray(verts, dtype=np.float64)[faces] - lo) / h
-    max_voxels = None
+    limit = None
     if budget is not None:
         check_budget(estimate_voxels(tri, n, solid), budget, f"depth {depth}{' solid' if solid else ''}")
-        max_voxels = max((budget - BASE) // BYTES_PER_VOXEL, 0)
-    coords = voxelize_surface(tri, n)
+        limit = voxel_limit(budget)
+    coords = voxelize_surface(tri, n, limit)
     if len(coords) == 0:
         raise Rend3rError("mesh has no area: every triangle has equal or collinear vertices")
     if solid:
-        fill = fill_solid(tri, n, None if max_voxels is None else max(max_voxels - len(coords), 0))
+        fill = fill_solid(tri, n, None if limit is None else max(limit - len(coords), 0))
         coords = _unique_rows(np.concatenate([coords, fill]), n)
     return coords, lo, h

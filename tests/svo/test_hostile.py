@@ -199,3 +199,24 @@ def test_render_cost_on_a_full_disk_keeps_nothing(sphere, tmp_path):
         assert list(disk.iterdir()) == []
     finally:
         subprocess.run(["umount", str(disk)], check=True)
+
+
+def test_binvox_run_bomb_is_refused_before_expanding(tmp_path):
+    """8 MB of runs standing for 2**30 solid voxels."""
+    dim = 1024
+    pairs, rest = divmod(dim ** 3, 255)
+    body = bytes([1, 255]) * pairs + bytes([1, rest])
+    (tmp_path / "b.binvox").write_bytes(b"#binvox 1\ndim 1024 1024 1024\ntranslate 0 0 0\nscale 1\ndata\n" + body)
+    r = _child("build", tmp_path / "b.binvox", "-o", tmp_path / "o.svo", "--max-memory", "1G")
+    assert r.returncode == 1 and "b.binvox: 1,073,741,824 solid voxels, over the" in r.stderr, r.stderr
+
+
+def test_sliver_triangles_count_in_the_estimate(tmp_path):
+    """Needles of no area crossing the grid: refused by the estimate, not after the work."""
+    rng = np.random.default_rng(1)
+    ends = rng.uniform(0, 1, (20000, 2, 3))
+    text = "".join(f"v {a} {b} {c}\nv {d} {e} {f}\nv {d} {e} {f + 1e-9}\n" for (a, b, c), (d, e, f) in ends)
+    text += "".join(f"f {3 * i + 1} {3 * i + 2} {3 * i + 3}\n" for i in range(len(ends)))
+    (tmp_path / "n.obj").write_text(text)
+    r = _run("build", tmp_path / "n.obj", "-o", tmp_path / "o.svo", "--depth", "12", "--max-memory", "1G")
+    assert r.exit_code == 1 and "voxels need an estimated" in r.output, r.output

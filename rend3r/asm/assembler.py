@@ -44,16 +44,18 @@ from .program import Emitted, Program, SourceLoc
 
 # Limits on what one run may be asked to do (docs/assembly.md, "Limits"): each bounds
 # time or memory, and reaching one is an error naming it, never a hang or a crash.
-#: Statements run after .rept expansion; an operator in a statement's operands and a
-#: line an .include reads count as one statement each.
+#: Statements run after .rept expansion. A statement the fast path does not take counts
+#: one more per operand and operator, and a line an .include reads counts as one: the
+#: count bounds the time as well as the words.
 MAX_STATEMENTS = 1 << 20
 #: Bytes of one source file (the main file or an included one).
 MAX_SOURCE = 32 << 20
 #: Lines and bytes read in one run, counting every file each time it is (re)read.
 MAX_LINES = 1 << 22
 MAX_READ = 64 << 20
-#: Characters of one line.
-MAX_LINE = 16_384
+#: Characters of one line (C's translation limit is 4,095): keeps the worst line (a
+#: few thousand tokens for the full parser) well under a second.
+MAX_LINE = 4_096
 #: Nesting of .include and of .rept blocks (each level is a level of recursion).
 MAX_INCLUDE_DEPTH = 32
 MAX_REPT_DEPTH = 64
@@ -119,7 +121,7 @@ class _Stmt:
     file: str
     line: int
     text: str
-    cost: int = 1  # statements it counts as: one, plus one per operator in its operands
+    cost: int = 1  # what it counts against MAX_STATEMENTS (see _cost)
 
 
 @dataclass
@@ -141,18 +143,19 @@ class _Rept:
     body: list = field(default_factory=list)
 
 
-def _operators(stmt: Statement) -> int:
-    """The operators in a statement's operands (counted without recursion)."""
+def _cost(stmt: Statement) -> int:
+    """What a parsed statement counts against MAX_STATEMENTS: one, plus one per node of
+    its operands' trees (names, literals and operators; counted without recursion), so
+    the count follows the time it takes to run."""
     todo = list(stmt.operands if isinstance(stmt, Instruction) else
                 (stmt.expr,) if isinstance(stmt, Assignment) else stmt.args)
-    count = 0
+    count = 1
     while todo:
         node = todo.pop()
+        count += 1
         if isinstance(node, Neg):
-            count += 1
             todo.append(node.operand)
         elif isinstance(node, BinOp):
-            count += 1
             todo += (node.left, node.right)
     return count
 
@@ -322,9 +325,9 @@ class Assembler:
                     body = None
                     self.run_rept(done, context)
             elif body is not None:
-                body.append(_Stmt(_folded(stmt), file, lineno, line, 1 + _operators(stmt)))
+                body.append(_Stmt(_folded(stmt), file, lineno, line, _cost(stmt)))
             else:
-                self.run_statement(_Stmt(stmt, file, lineno, line, 1 + _operators(stmt)), context)
+                self.run_statement(_Stmt(stmt, file, lineno, line, _cost(stmt)), context)
         for node in open_repts:
             self.where = (node.file, node.line, node.text, context)
             self.error(".rept without a matching .endr", node.stmt.col, node.stmt.end)
@@ -338,7 +341,7 @@ class Assembler:
         file, line, _, _ = self.where
         self.where = (file, line, "", ())
         self.error(f"program too large: more than {MAX_STATEMENTS:,} statements after .rept expansion "
-                   "(an operator or a line read by .include counts as one)")
+                   "(each operand, operator and line read by .include counts as one)")
         raise _Abort
 
     # -- running -----------------------------------------------------------------------

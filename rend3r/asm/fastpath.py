@@ -96,19 +96,38 @@ def _round(x: float, text: str) -> int | None:
     cannot hold and that has at most 12 significant bits takes the exact path
     (:func:`round_literal`).
     """
+    bits = half_bits(x)
+    if bits is not None or not _may_be_tie(x):
+        return bits
+    negative = text.startswith("-")
+    body = text[1:] if negative else text
+    r = round_literal(int(body, 2) if body[:2].lower() == "0b" else Fraction(body), negative=negative)
+    return None if (r.overflow or r.underflow or r.relative_error > 0.01) else r.bits
+
+
+def half_bits(x: float) -> int | None:
+    """float16 bits of ``x``, the correctly rounded float64 of an exact value, or None
+    when that value needs the exact path: ``x`` may be a float16 midpoint (see
+    :func:`_round`), or the value overflows, underflows or is near the 1% warning."""
     try:
         packed = _HALF.pack(x)
     except OverflowError:
         return None
     back = _HALF.unpack(packed)[0]
     if back != x and (math.frexp(x)[0] * 4096.0).is_integer():
-        negative = text.startswith("-")
-        body = text[1:] if negative else text
-        r = round_literal(int(body, 2) if body[:2].lower() == "0b" else Fraction(body), negative=negative)
-        return None if (r.overflow or r.underflow or r.relative_error > 0.01) else r.bits
+        return None
     if back == 0.0 and x != 0.0 or math.isinf(back) or abs(back - x) > 0.0099 * abs(x):
         return None
     return int.from_bytes(packed, "little")
+
+
+def _may_be_tie(x: float) -> bool:
+    """``x`` is not a float16 and has at most 12 significant bits (a midpoint's)."""
+    try:
+        back = _HALF.unpack(_HALF.pack(x))[0]
+    except OverflowError:
+        return False
+    return back != x and (math.frexp(x)[0] * 4096.0).is_integer()
 
 
 def _int_bits(text: str, width: int) -> int | None:

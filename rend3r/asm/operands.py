@@ -29,6 +29,7 @@ from ..isa.tables import (
 )
 from ..isa.targets import Target
 from .expressions import Value, describe
+from .fastpath import half_bits
 from .parser import Instruction, Operand, Ref
 
 _EXTENSION_OF = {m: name for name, ms in EXTENSIONS.items() for m in ms}
@@ -221,6 +222,13 @@ class OperandEncoder:
                 node.col,
                 node.end,
             )
+        if v.number and not v.negative_zero:
+            try:
+                bits = half_bits(float(v.number))  # quick when no diagnostic can follow
+            except OverflowError:
+                bits = None
+            if bits is not None:
+                return bits
         key = (v.number, v.negative_zero)
         r = self.rounded.get(key)
         if r is None:

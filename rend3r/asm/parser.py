@@ -144,6 +144,8 @@ def parse_number(text: str, token_type: str) -> tuple[int | Fraction, str]:
     0h gives the raw 16 bits. ``_`` may separate digits (not lead, trail or double).
     """
     if token_type == "NUMBER":
+        if text.isdigit() and text.isascii() and len(text) <= MAX_DIGITS:
+            return int(text), ""
         if not _DEC.fullmatch(text) or not any(c.isdigit() for c in text.split("e")[0].split("E")[0]):
             return 0, f"malformed number '{quote(text)}'"
         mantissa, _, exponent = text.replace("_", "").lower().partition("e")

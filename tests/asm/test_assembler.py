@@ -117,7 +117,7 @@ def test_statement_limit(monkeypatch):
     r = assemble_source(".rept 10, i\n.rept 10, j\nnr\n.endr\n.endr\ner\ner")
     assert [d.message for d in r.errors] == [
         "program too large: more than 50 statements after .rept expansion "
-        "(an operator or a line read by .include counts as one)"]
+        "(each operand, operator and line read by .include counts as one)"]
 
 
 def test_huge_literals_are_bounded():

@@ -92,12 +92,11 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
     from .budget import check_budget, default_budget, max_voxels
     from .fileformat import SvoModel, encode_svo
     from .mesh_io import encode_binvox, read_binvox, read_mesh
-    from .octree import build_octree
+    from .octree import build_octree_codes, morton_decode, morton_encode
     from .outputs import write_all
-    from .voxelize import voxelize
+    from .voxelize import voxelize_codes
 
     budget = max_memory or default_budget()
-
     start = time.perf_counter()
     if Path(mesh).suffix.lower() == ".binvox":
         coords, dim, translate, scale = read_binvox(mesh, max_voxels(budget))
@@ -113,22 +112,30 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
                 and np.all(np.isfinite(lo + h * (1 << depth)))):
             raise Rend3rError(f"{mesh}: binvox translate and scale must be finite, scale positive")
         check_budget(len(coords), budget, mesh)
+        codes = np.unique(morton_encode(coords, depth))
+        del coords
     else:
         if depth is None:
             raise Rend3rError("--depth is required for mesh input")
         verts, faces = read_mesh(mesh)
         try:
-            coords, lo, h = voxelize(verts, faces, depth, solid, budget)
+            codes, lo, h = voxelize_codes(verts, faces, depth, solid, budget)
         except Rend3rError as exc:
             raise Rend3rError(f"{mesh}: {exc}") from None
-    tree = build_octree(coords, depth, ptr_bits)
+        del verts, faces
+    count = len(codes)
+    # the binvox bytes first: the coordinates they need are freed before the octree is built
+    binvox = (encode_binvox(morton_decode(codes, depth), 1 << depth, tuple(lo), h * (1 << depth))
+              if binvox_out else None)
+    tree = build_octree_codes(codes, depth, ptr_bits)
+    del codes
     hi = lo + h * (1 << depth)
     bounds = tuple(float(x) for x in lo) + tuple(float(x) for x in hi)
-    outputs = [(output, encode_svo(SvoModel(tree, bounds, len(coords))))]
-    if binvox_out:
-        outputs.append((binvox_out, encode_binvox(coords, 1 << depth, tuple(lo), h * (1 << depth))))
+    outputs = [(output, encode_svo(SvoModel(tree, bounds, count)))]
+    if binvox is not None:
+        outputs.append((binvox_out, binvox))
     write_all(outputs)
-    click.echo(f"{output}: depth {depth}, {len(coords)} voxels, {len(tree.words)} words "
+    click.echo(f"{output}: depth {depth}, {count} voxels, {len(tree.words)} words "
                f"({tree.far_count()} far pointers), {time.perf_counter() - start:.2f} s")
 
 

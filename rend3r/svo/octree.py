@@ -90,8 +90,8 @@ def _level_nodes(codes: np.ndarray, depth: int) -> list[tuple[np.ndarray, np.nda
         parents = child_codes >> 3  # sorted, because child_codes are
         first = np.flatnonzero(np.r_[True, parents[1:] != parents[:-1]])
         keys = parents[first]
-        bits = np.left_shift(1, child_codes & 7)
-        valid = np.bitwise_or.reduceat(bits, first) if len(first) else np.zeros(0, np.int64)
+        bits = np.left_shift(np.uint8(1), (child_codes & 7).astype(np.uint8))  # 1 byte a child
+        valid = np.bitwise_or.reduceat(bits, first) if len(first) else np.zeros(0, np.uint8)
         levels.append((keys, valid.astype(np.int64), first))
         child_codes = keys
     return levels[::-1]
@@ -107,15 +107,23 @@ def build_octree(coords: np.ndarray, depth: int, ptr_bits: int = DEFAULT_PTR_BIT
     """
     if not 1 <= depth <= MAX_DEPTH:
         raise Rend3rError(f"octree depth must be 1..{MAX_DEPTH}, got {depth}")
-    if not 4 <= ptr_bits <= 15:
-        raise Rend3rError(f"pointer width must be 4..15 bits, got {ptr_bits}")
     coords = np.asarray(coords, dtype=np.int64).reshape(-1, 3)
     if len(coords) == 0:
         raise Rend3rError("no voxels to build an octree from")
     if coords.min() < 0 or coords.max() >= (1 << depth):
         raise Rend3rError(f"voxel coordinates outside [0, {1 << depth})")
     codes = np.sort(morton_encode(coords, depth))
-    codes = codes[np.r_[True, codes[1:] != codes[:-1]]]
+    return build_octree_codes(codes[np.r_[True, codes[1:] != codes[:-1]]], depth, ptr_bits)
+
+
+def build_octree_codes(codes: np.ndarray, depth: int, ptr_bits: int = DEFAULT_PTR_BITS) -> Octree:
+    """:func:`build_octree` from sorted unique Morton codes (:func:`morton_encode`)."""
+    if not 1 <= depth <= MAX_DEPTH:
+        raise Rend3rError(f"octree depth must be 1..{MAX_DEPTH}, got {depth}")
+    if not 4 <= ptr_bits <= 15:
+        raise Rend3rError(f"pointer width must be 4..15 bits, got {ptr_bits}")
+    if len(codes) == 0:
+        raise Rend3rError("no voxels to build an octree from")
     levels = _level_nodes(codes, depth)
     n_levels = len(levels)
     counts = [len(k) for k, _, _ in levels]

@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import Rend3rError
 from .budget import check_budget, estimate_voxels
 from .budget import max_voxels as voxel_limit
+from .octree import morton_decode, morton_encode
 
 _CHUNK = 1 << 19  # candidate (triangle, voxel) pairs per vectorised batch
 MAX_COORD = 1e150
@@ -164,6 +165,11 @@ def voxelize_surface(tri_grid: np.ndarray, n: int, max_voxels: int | None = None
     are skipped; M is 0 when every triangle is degenerate. With ``max_voxels``, more
     voxels than that are refused with a Rend3rError as soon as the batches hold them.
     """
+    return _rows(_surface_keys(tri_grid, n, lambda c: _keys(c, n), max_voxels), n)
+
+
+def _surface_keys(tri_grid: np.ndarray, n: int, key, max_voxels: int | None) -> np.ndarray:
+    """Sorted unique ``key(coords)`` of the voxels the triangles overlap, batch by batch."""
     tri_grid = tri_grid[np.any(np.cross(tri_grid[:, 1] - tri_grid[:, 0], tri_grid[:, 2] - tri_grid[:, 0]), axis=1)]
     tri_grid = _split_large(tri_grid, n)
     weight = _weight(tri_grid, n)
@@ -171,7 +177,7 @@ def voxelize_surface(tri_grid: np.ndarray, n: int, max_voxels: int | None = None
     keys: list[np.ndarray] = []
     held = 0
     for s in _batches(weight, _CHUNK):
-        keys.append(_keys(_surface_chunk(tri_grid[s], n), n))
+        keys.append(np.unique(key(_surface_chunk(tri_grid[s], n))))
         held += len(keys[-1])
         if max_voxels is not None and held > max_voxels:
             keys = [np.unique(np.concatenate(keys))]
@@ -179,7 +185,7 @@ def voxelize_surface(tri_grid: np.ndarray, n: int, max_voxels: int | None = None
             if held > max_voxels:
                 raise Rend3rError(f"the surface holds more than {max_voxels:,} voxels, the most the memory "
                                   "budget allows (--max-memory; use a smaller --depth)")
-    return _rows(np.unique(np.concatenate(keys)) if keys else np.empty(0, np.int64), n)
+    return np.unique(np.concatenate(keys)) if keys else np.empty(0, np.int64)
 
 
 def fill_solid(tri_grid: np.ndarray, n: int, max_voxels: int | None = None) -> np.ndarray:
@@ -227,10 +233,22 @@ def fill_solid(tri_grid: np.ndarray, n: int, max_voxels: int | None = None) -> n
 
 def voxelize(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool = False,
              budget: int | None = None) -> tuple[np.ndarray, np.ndarray, float]:
-    """Voxelise a triangle mesh: (voxel coords (M, 3), lo corner, voxel size h).
+    """Voxelise a triangle mesh: (voxel coords (M, 3) sorted by x, y, z; lo corner; voxel size h).
 
-    With ``budget`` (bytes) the build is refused up front when its estimate
-    (:mod:`rend3r.svo.budget`) exceeds it, and the solid fill again on its exact count.
+    See :func:`voxelize_codes`, which this decodes.
+    """
+    codes, lo, h = voxelize_codes(verts, faces, depth, solid, budget)
+    return _unique_rows(morton_decode(codes, depth), 1 << depth), lo, h
+
+
+def voxelize_codes(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool = False,
+                   budget: int | None = None) -> tuple[np.ndarray, np.ndarray, float]:
+    """Voxelise a triangle mesh: (sorted unique Morton codes (M,), lo corner, voxel size h).
+
+    Codes (8 bytes a voxel) are what the octree builder sorts; coordinates are never held
+    for the whole mesh. With ``budget`` (bytes) the build is refused up front when its
+    estimate (:mod:`rend3r.svo.budget`) exceeds it, and again on the exact counts of the
+    surface batches and the solid fill before they are expanded.
     """
     faces = np.asarray(faces, dtype=np.int64)
     if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) == 0:
@@ -244,10 +262,10 @@ def voxelize(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool = Fal
     if budget is not None:
         check_budget(estimate_voxels(tri, n, solid), budget, f"depth {depth}{' solid' if solid else ''}")
         limit = voxel_limit(budget)
-    coords = voxelize_surface(tri, n, limit)
-    if len(coords) == 0:
+    codes = _surface_keys(tri, n, lambda c: morton_encode(c, depth), limit)
+    if len(codes) == 0:
         raise Rend3rError("mesh has no area: every triangle has equal or collinear vertices")
     if solid:
-        fill = fill_solid(tri, n, None if limit is None else max(limit - len(coords), 0))
-        coords = _unique_rows(np.concatenate([coords, fill]), n)
-    return coords, lo, h
+        fill = fill_solid(tri, n, None if limit is None else max(limit - len(codes), 0))
+        codes = np.union1d(codes, morton_encode(fill, depth))
+    return codes, lo, h

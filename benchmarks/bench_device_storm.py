@@ -57,17 +57,26 @@ def proc_status(pid: int) -> dict[str, int]:
     return fields
 
 
+def _read(fh) -> bytes:
+    fh.seek(0)
+    return fh.read()
+
+
 def storm(commits: int, seconds: float, size: str, out: Path, frames: int = 8) -> dict[str, float]:
     """Run the storm; return the figures (threads, RSS, commits acknowledged, files, latency)."""
     programs = sphere_programs(commits)
     final_load = (commits - 1) % 65535 + 1
     server = socket.create_server(("127.0.0.1", 0))
     port = server.getsockname()[1]
+    log = tempfile.TemporaryFile()  # the device logs every commit: a pipe nobody reads would stall it
     device = subprocess.Popen([sys.executable, "-m", "rend3r", "device", "--serial", f"socket://127.0.0.1:{port}",
-                               "-o", str(out), "--size", size, "--frames", str(frames)],
-                              stderr=subprocess.PIPE, text=True)
+                               "-o", str(out), "--size", size, "--frames", str(frames)], stderr=log)
     conn, _ = server.accept()
     server.close()
+    while b"listening on" not in _read(log):  # pyserial drains the socket while it opens the port
+        if device.poll() is not None:
+            raise RuntimeError(f"rend3r device exited: {_read(log).decode()}")
+        time.sleep(0.02)
     acks: list[Frame] = []
     last_commit_acked = [0.0]
     done = threading.Event()
@@ -100,7 +109,7 @@ def storm(commits: int, seconds: float, size: str, out: Path, frames: int = 8) -
             time.sleep(max(0.0, start + (i + 1) * seconds / commits - time.monotonic()))
         sent = time.monotonic()
         last = out / f"run{commits:04d}_frame0000.png"
-        while not last.exists() and time.monotonic() - sent < 300:
+        while not last.exists() and time.monotonic() - sent < 120:
             samples.append(proc_status(device.pid))
             time.sleep(0.02)
         latency = time.monotonic() - sent
@@ -113,8 +122,9 @@ def storm(commits: int, seconds: float, size: str, out: Path, frames: int = 8) -
     finally:
         done.set()
         device.terminate()
-        device.communicate(timeout=60)
+        device.wait(timeout=60)
         conn.close()
+        log.close()
     committed = sum(a.type == FrameType.ACK and a.ref == FrameType.COMMIT for a in acks)
     return {
         "commits": commits, "seconds": sent - start, "acked": committed, "loads": status.loads,

@@ -22,6 +22,7 @@ from rend3r.transport.protocol import (
 )
 from rend3r.transport.session import load_frames
 
+from cobs_patterns import BOUNDARY_RUNS, boundary_words
 from sim_links import CLOCK_NS, Pins, eth_for, serial_bytes, wire_bytes
 
 REPO = Path(__file__).resolve().parents[2]
@@ -341,3 +342,33 @@ async def rmii_replays_rend3r_send_pcap(dut):
     words = assembled("tri_cube.asm")
     assert await pins.read_memory(len(words)) == words
     assert dut.running.value == 1
+
+
+#: Words per DATA frame of the boundary loads: all of BOUNDARY_RUNS' frames fit a 1,024-word bank.
+BOUNDARY_FRAME_WORDS = min(256, (1 << AW) // len(BOUNDARY_RUNS))
+
+
+async def load_boundary_frames(dut, link: str) -> None:
+    """DATA frames of ~800 bytes whose zeros follow runs of 253-256 non-zero bytes land exact.
+
+    Last in this file: the 1,020-word load leaves words in both banks beyond the shorter
+    programs that the earlier tests check are followed by zeros.
+    """
+    pins = await bring_up(dut)
+    sender = Sender(pins, link, random.Random(7))
+    words = boundary_words(frame_words=BOUNDARY_FRAME_WORDS)
+    assert await sender.load(words, chunk=BOUNDARY_FRAME_WORDS) == 0
+    await check_loaded(pins, sender, words)
+    assert (await sender.status()).malformed == 0
+
+
+@cocotb.test()
+async def uart_boundary_frames(dut):
+    """COBS block boundaries (a 254-byte run then a zero, 253/255/256, zeros back to back) over UART."""
+    await load_boundary_frames(dut, "uart")
+
+
+@cocotb.test()
+async def rmii_boundary_frames(dut):
+    """The same frames over RMII: no COBS, but the receiver's buffer and CRC see > 254 bytes."""
+    await load_boundary_frames(dut, "rmii")

@@ -29,7 +29,7 @@ def build_and_run(tmp: Path, params: dict[str, int], env: dict[str, str]) -> Non
     finally:
         sys.path.remove(str(FIRMWARE / "tests"))
     tests, failed = runner_mod.get_results(results)
-    assert tests == 7 and failed == 0, f"{failed} of {tests} cocotb tests failed; see {tmp}"
+    assert tests == 9 and failed == 0, f"{failed} of {tests} cocotb tests failed; see {tmp}"
 
 
 def test_loader_cosim(tmp_path: Path) -> None:

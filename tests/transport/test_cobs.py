@@ -9,7 +9,8 @@ import threading
 from pathlib import Path
 
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from rend3r.transport import cobs
 from rend3r.transport.cli import serve
@@ -19,7 +20,7 @@ from rend3r.transport.protocol import program_crc
 from rend3r.transport.session import Sender, load_frames
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "firmware" / "tests"))
-from cobs_patterns import BOUNDARY_RUNS, boundary_words  # noqa: E402
+from cobs_patterns import BOUNDARY_RUNS, boundary_words
 
 X = b"\x5a"
 

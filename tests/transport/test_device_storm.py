@@ -16,8 +16,8 @@ import pytest
 
 HERE = Path(__file__).resolve().parent
 sys.path[:0] = [str(HERE.parents[1] / "benchmarks"), str(HERE)]  # the storm driver, the PNG helpers
-from bench_device_storm import sphere_programs, storm  # noqa: E402
-from test_execute import read_png, rendered_png  # noqa: E402
+from bench_device_storm import sphere_programs, storm
+from test_execute import read_png, rendered_png
 
 
 @pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="needs /proc to count threads")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,7 +20,7 @@ from ..errors import Rend3rError
 Key = tuple[int, tuple[int, int], int | None, str, int]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Record:
     """One traced value, with where it came from (file line)."""
 
@@ -41,54 +42,109 @@ class Record:
 def _decimal(v: object, where: str) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float, str)):
         raise Rend3rError(f"{where}: 'dec' must be a number or 'nan'/'inf'/'-inf'")
+    if isinstance(v, str) and len(v) > 64:
+        raise Rend3rError(f"{where}: 'dec' is a string of {len(v):,} characters, not a number")
     try:
         return float(v)
     except ValueError:
         raise Rend3rError(f"{where}: 'dec' {v!r} is not a number") from None
 
 
+#: Largest trace file read (32 MiB: ~350,000 emulator records, ~300 MB and ~10 s once parsed).
+MAX_TRACE = 32 << 20
+#: Deepest JSON nesting a line may have (a record needs 2: the object and its pixel list).
+MAX_DEPTH = 16
+#: Most digits a JSON integer or a ``hex`` value may have (a 64-bit value needs 20 or 16).
+MAX_DIGITS = 24
+#: Longest stage name (the emulator's longest is under 20 characters).
+MAX_STAGE = 200
+_HEX = re.compile(r"-?0[xX][0-9a-fA-F]{1,%d}" % MAX_DIGITS, re.ASCII)
+_BRACKETS = re.compile(r'"(?:[^"\\]|\\.)*"?|[\[\]{}]')
+
+
+class _TooLong(ValueError):
+    """A JSON integer with more than :data:`MAX_DIGITS` digits."""
+
+
+def _int(text: str) -> int:
+    if len(text.lstrip("-")) > MAX_DIGITS:
+        raise _TooLong(f"an integer of {len(text.lstrip('-')):,} digits (at most {MAX_DIGITS})")
+    return int(text)
+
+
+_DECODER = json.JSONDecoder(parse_int=_int)
+
+
+def _check_depth(text: str, where: str) -> None:
+    """Refuse nesting deeper than :data:`MAX_DEPTH` before the JSON parser recurses into it
+    (linear in the line: strings are skipped whole)."""
+    if text.count("[") + text.count("{") <= MAX_DEPTH:
+        return
+    depth = 0
+    for m in _BRACKETS.finditer(text):
+        c = m[0]
+        if c in "[{":
+            depth += 1
+            if depth > MAX_DEPTH:
+                raise Rend3rError(f"{where}:{m.start() + 1}: JSON nested deeper than {MAX_DEPTH} levels: not a trace")
+        elif c in "]}":
+            depth -= 1
+
+
+def _integer(obj: dict, key: str, where: str, default: object = None, *, nullable: bool = False,
+             minimum: int | None = None) -> int | None:
+    v = obj.get(key, default)
+    if v is None and nullable:
+        return None
+    if not isinstance(v, int) or isinstance(v, bool) or (minimum is not None and v < minimum):
+        kind = "a non-negative integer" if minimum == 0 else "an integer"
+        raise Rend3rError(f"{where}: {key!r} must be {kind}{' or null' if nullable else ''}")
+    return v
+
+
 def parse_record(text: str, where: str, line: int) -> Record:
     """One JSON line -> Record (Rend3rError naming ``where`` when malformed)."""
+    _check_depth(text, where)
     try:
-        obj = json.loads(text)
+        obj = _DECODER.decode(text)
     except json.JSONDecodeError as exc:
-        raise Rend3rError(f"{where}: not JSON ({exc.msg})") from None
+        raise Rend3rError(f"{where}:{exc.colno}: not JSON ({exc.msg})") from None
+    except _TooLong as exc:
+        raise Rend3rError(f"{where}: not a trace value: {exc}") from None
     if not isinstance(obj, dict):
         raise Rend3rError(f"{where}: a trace line must be a JSON object")
     missing = [k for k in ("pixel", "stage", "hex", "dec") if k not in obj]
     if missing:
         raise Rend3rError(f"{where}: missing field(s) {', '.join(missing)}")
     px = obj["pixel"]
-    if not (isinstance(px, list) and len(px) == 2 and all(isinstance(c, int) and not isinstance(c, bool) for c in px)):
-        raise Rend3rError(f"{where}: 'pixel' must be [x, y] integers")
-    shape = obj.get("shape")
-    if shape is not None and (not isinstance(shape, int) or isinstance(shape, bool)):
-        raise Rend3rError(f"{where}: 'shape' must be an integer or null")
-    frame = obj.get("frame", 0)
-    if not isinstance(frame, int) or isinstance(frame, bool):
-        raise Rend3rError(f"{where}: 'frame' must be an integer")
-    if not isinstance(obj["stage"], str):
-        raise Rend3rError(f"{where}: 'stage' must be a string")
-    try:
-        bits = int(str(obj["hex"]), 16)
-    except ValueError:
-        raise Rend3rError(f"{where}: 'hex' {obj['hex']!r} is not hexadecimal") from None
-    return Record(frame, (px[0], px[1]), shape, obj["stage"], bits, _decimal(obj["dec"], where), line)
+    if not (isinstance(px, list) and len(px) == 2
+            and all(isinstance(c, int) and not isinstance(c, bool) and c >= 0 for c in px)):
+        raise Rend3rError(f"{where}: 'pixel' must be [x, y] non-negative integers")
+    shape = _integer(obj, "shape", where, nullable=True)
+    frame = _integer(obj, "frame", where, 0, minimum=0)
+    if not isinstance(obj["stage"], str) or not 0 < len(obj["stage"]) <= MAX_STAGE:
+        raise Rend3rError(f"{where}: 'stage' must be a name of 1 to {MAX_STAGE} characters")
+    hx = obj["hex"]
+    if not (isinstance(hx, str) and _HEX.fullmatch(hx)):
+        shown = repr(hx) if len(repr(hx)) <= 40 else repr(hx)[:37] + "..."
+        raise Rend3rError(f"{where}: 'hex' must be a string like \"0x3c00\" (at most {MAX_DIGITS} digits), "
+                          f"not {shown}")
+    return Record(frame, (px[0], px[1]), shape, obj["stage"], int(hx, 16), _decimal(obj["dec"], where), line)
 
 
 def read_trace(path: Path) -> list[Record]:
     """All records of a trace file, in file order (blank lines are skipped)."""
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise Rend3rError(f"cannot read {path}: {exc.strerror or exc}") from None
+    from ..fileio import read_limited
+
+    data = read_limited(path, MAX_TRACE, what="trace")
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
         raise Rend3rError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x}): not a trace") from None
+    del data
     return [
-        parse_record(line, f"{path}:{n}", n) for n, line in enumerate(text.splitlines(), 1) if line.strip()
+        parse_record(line, f"{path}:{n}", n) for n, line in enumerate(text.split("\n"), 1) if line.strip()
     ]
 
 

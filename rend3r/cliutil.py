@@ -1,7 +1,8 @@
-"""Option parsing shared by the commands: image sizes ``WxH``, thread counts."""
+"""Option parsing shared by the commands: image sizes ``WxH``, thread counts, memory budgets."""
 
 from __future__ import annotations
 
+import os
 import re
 
 import click
@@ -44,3 +45,54 @@ SIZE = SizeType()
 #: ``--jobs N``: threads rendering each frame (0, the default: every core this process may use).
 JOBS = click.option("--jobs", type=click.IntRange(0, 256), default=0, show_default=True, metavar="N",
                     help="Threads rendering each frame; 0 uses every core. The image does not depend on it.")
+
+
+_BYTES = re.compile(r"\s*([0-9]{1,12}(?:\.[0-9]{1,6})?)\s*([KMGT]?)(?:i?B)?\s*", re.ASCII | re.IGNORECASE)
+_UNITS = {"": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
+
+
+def parse_bytes(text: str) -> int:
+    """``"512M"``, ``"4G"``, ``"1.5GiB"``, ``"100000"`` -> bytes (binary units); ValueError otherwise."""
+    m = _BYTES.fullmatch(text)
+    if not m:
+        raise ValueError(f"expected a size such as 512M or 4G, not {text!r}")
+    value = int(float(m[1]) * _UNITS[m[2].upper()])
+    if value < 1 << 20:
+        raise ValueError(f"a memory budget below 1M cannot run anything, not {text!r}")
+    return value
+
+
+def default_memory() -> int:
+    """Half of this machine's memory, and no more than this process's address-space limit
+    allows (less 1 GiB for the interpreter, libraries and thread stacks)."""
+    import resource
+
+    try:
+        physical = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError):
+        physical = 8 << 30
+    budget = physical // 2
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft != resource.RLIM_INFINITY:
+        budget = min(budget, max(soft - (1 << 30), soft // 4))
+    return budget
+
+
+class BytesType(click.ParamType):
+    """A click parameter type for memory sizes (bad values exit 2)."""
+
+    name = "SIZE"
+
+    def convert(self, value, param, ctx) -> int:
+        if isinstance(value, int):
+            return value
+        try:
+            return parse_bytes(str(value))
+        except ValueError as exc:
+            self.fail(str(exc), param, ctx)
+
+
+#: ``--max-memory SIZE``: refuse up front what would need more (None: :func:`default_memory`).
+MAX_MEMORY = click.option("--max-memory", type=BytesType(), metavar="SIZE",
+                          help="Refuse, before any work, a run estimated to need more memory than this "
+                               "(e.g. 2G; default: half of this machine's memory).")

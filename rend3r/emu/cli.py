@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import io
-import os
 import sys
+import warnings
 
 import click
 
-from ..cliutil import JOBS, SIZE
+from ..cliutil import JOBS, MAX_MEMORY, SIZE
 from ..errors import Rend3rError
 
 _EPILOG = """\b
@@ -32,10 +32,22 @@ def _colour(ctx, param, value: str) -> int:
     return c
 
 
+def _pattern(ctx, param, value: str | None) -> str | None:
+    from .image import check_pattern
+
+    if value is not None:
+        try:
+            check_pattern(value)
+        except ValueError as exc:
+            raise click.BadParameter(str(exc)) from None
+    return value
+
+
 @click.command("emulate", epilog=_EPILOG)
 @click.argument("program", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", help="PNG per frame: a name, or a pattern like out/frame_{n:03}.png for several "
-              "(a pattern's folders are created; a plain name's folder must exist).")
+@click.option("-o", "--output", callback=_pattern, help="PNG per frame: a name, or a pattern like out/frame_{n:03}.png for several "
+              "(a pattern's folders are created; a plain name's folder must exist). Only {n} may appear in braces, "
+              "with at most a zero-padded width; write a literal brace as {{ or }}.")
 @click.option("--frames", type=click.IntRange(min=1), help="Render at most N frames (required for programs that loop with lr).")
 @click.option("--mode", type=click.Choice(["raytrace", "raster", "hybrid"]), help="How SE/SD data is read (default: from the source's sp/tr, else raytrace); hybrid: shapes and triangles in one frame (docs/isa-extensions.md).")
 @click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
@@ -44,8 +56,8 @@ def _colour(ctx, param, value: str) -> int:
 @click.option("--background", default="0x0000", show_default=True, callback=_colour, help="RGB565 colour where no shape is hit.")
 @click.option("--depth", "visibility", type=click.Choice(["zbuffer", "painter"]), default="zbuffer", show_default=True,
               help="Raster visibility: a depth buffer, or the paper's painter order by centroid distance.")
-@click.option("--depth-image", "depth_path", help="Depth image per frame: .npy (float32 distances) or 16-bit PNG.")
-@click.option("--provenance", "prov_path", help="Which shape made each pixel: .npy (int32, -1 none) or PNG.")
+@click.option("--depth-image", "depth_path", callback=_pattern, help="Depth image per frame: .npy (float32 distances) or 16-bit PNG.")
+@click.option("--provenance", "prov_path", callback=_pattern, help="Which shape made each pixel: .npy (int32, -1 none) or PNG.")
 @click.option("--gif", "gif_path", help="All frames as an animated GIF.")
 @click.option("--apng", "apng_path", help="All frames as an animated PNG (lossless; .png or .apng).")
 @click.option("--stats", "show_stats", is_flag=True, help="Print counters, times and the paper's device estimate.")
@@ -54,14 +66,24 @@ def _colour(ctx, param, value: str) -> int:
 @click.option("--trace-pixel", "trace_pixels", multiple=True, metavar="X,Y", help="Trace every float16 intermediate of this pixel (repeatable; docs/trace.md).")
 @click.option("--trace", "trace_path", help="Write pixel traces (JSON lines) to FILE instead of standard output.")
 @JOBS
+@MAX_MEMORY
 def emulate_command(program, output, frames, mode, precision, subnormals, size, background, visibility,
                     depth_path, prov_path, gif_path, apng_path, show_stats, profile, quirks, trace_pixels,
-                    trace_path, jobs) -> None:
-    """Run a REND3R PROGRAM (source or memory image) and render its frames."""
+                    trace_path, jobs, max_memory) -> None:
+    """Run a REND3R PROGRAM (source or memory image) and render its frames.
+
+    Its outputs are all or nothing: they appear only when every one of them was written;
+    after an error, no file of the run remains and files it would have replaced are kept.
+    """
+    import numpy as np
+
+    from ..cliutil import default_memory
+    from .budget import estimate_memory
     from .image import (ANIMATION_KINDS, DATA_KINDS, FRAME_KINDS, check_output, frame_path, is_pattern,
                         save_animation, save_depth, save_png, save_provenance)
     from .loader import load_program
     from .options import EmuOptions
+    from .outputs import Outputs
     from .processor import execute
     from .quirks import apply_quirks, quirk_names
     from .run import run_program
@@ -77,12 +99,12 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
         raise Rend3rError(f"--trace-pixel: {exc}") from None
     if trace_path and not pixels:
         raise Rend3rError("--trace FILE needs at least one --trace-pixel X,Y")
-    for path, kinds in ((output, FRAME_KINDS), (depth_path, DATA_KINDS), (prov_path, DATA_KINDS),
-                        (gif_path, ANIMATION_KINDS["gif"]), (apng_path, ANIMATION_KINDS["apng"])):
+    animate = gif_path or apng_path
+    named = ((output, FRAME_KINDS), (depth_path, DATA_KINDS), (prov_path, DATA_KINDS),
+             (gif_path, ANIMATION_KINDS["gif"]), (apng_path, ANIMATION_KINDS["apng"]))
+    for path, kinds in named:
         if path:
-            check_output(path, kinds, make_parents=is_pattern(path))
-    if trace_path and not os.path.isdir(os.path.dirname(trace_path) or "."):
-        raise Rend3rError(f"{trace_path}: folder {os.path.dirname(trace_path)} does not exist")
+            check_output(path, kinds, make_parents=path in (output, depth_path, prov_path) and is_pattern(path))
     loaded = load_program(program)
     options = EmuOptions(precision=precision, subnormals=subnormals, mode=mode or loaded.mode_hint or "raytrace",
                          width=size[0], height=size[1], background=background, depth=visibility, jobs=jobs)
@@ -98,17 +120,31 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
     for opt, path in (("-o", output), ("--depth-image", depth_path), ("--provenance", prov_path)):
         if path and count > 1 and not is_pattern(path):
             raise Rend3rError(f"the program renders {count} frames: {opt} needs a pattern such as out/frame_{{n:03}}.png")
-    animate = gif_path or apng_path
+    budget = max_memory or default_memory()
+    need, parts = estimate_memory(options.mode, options.width, options.height, count,
+                                  [p for p in (output, depth_path, prov_path) if p], animate)
+    if need > budget:
+        raise Rend3rError(f"a {options.width}x{options.height} {options.mode} run with these outputs needs about "
+                          f"{need / 2**30:.1f} GiB ({parts}); the memory budget is {budget / 2**30:.1f} GiB "
+                          f"(--max-memory): render fewer pixels or frames, or raise the budget")
+    outputs = Outputs()
+    for path in (output, depth_path, prov_path):
+        if path:
+            for n in range(count) if is_pattern(path) else (0,):
+                outputs.reserve(frame_path(path, n), make_parents=is_pattern(path))
+    for path in (animate, trace_path):
+        if path:
+            outputs.reserve(path)
     bar = _progress_bar(count)
     rgb_frames = []
 
     def on_frame(frame) -> None:
         if output:
-            save_png(frame.rgb565, frame_path(output, frame.number), make_parents=is_pattern(output))
+            save_png(frame.rgb565, frame_path(output, frame.number), sink=outputs.write)
         if depth_path:
-            save_depth(frame.depth, frame_path(depth_path, frame.number), make_parents=is_pattern(depth_path))
+            save_depth(frame.depth, frame_path(depth_path, frame.number), sink=outputs.write)
         if prov_path:
-            save_provenance(frame.provenance, frame_path(prov_path, frame.number), make_parents=is_pattern(prov_path))
+            save_provenance(frame.provenance, frame_path(prov_path, frame.number), sink=outputs.write)
         if animate:
             rgb_frames.append(frame.rgb565)
 
@@ -127,20 +163,23 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
         def on_scene(scene, number: int) -> None:
             tracer(scene, options, number, pixels, sink)
 
-    try:
-        result = run_program(loaded.words, options, frames, on_frame, progress, keep_frames=False, on_scene=on_scene)
-    finally:
-        if bar is not None:
-            bar.render_finish()
-    if pixels:
+    # Extreme values (inf, NaN, 65504, huge cameras) are the renderer's documented input: their
+    # rays count as misses and are reported below, so numpy's own warnings are not shown.
+    with outputs, np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        try:
+            result = run_program(loaded.words, options, frames, on_frame, progress, keep_frames=False,
+                                 on_scene=on_scene)
+        finally:
+            if bar is not None:
+                bar.render_finish()
         if trace_path:
-            from ..fileio import write_atomic
-
-            write_atomic(trace_path, trace_buf.getvalue().encode())
-        else:
-            click.echo(trace_buf.getvalue(), nl=False)
-    if animate:
-        save_animation(rgb_frames, animate, "gif" if gif_path else "apng")
+            outputs.write(trace_path, trace_buf.getvalue().encode())
+        if animate:
+            save_animation(rgb_frames, animate, "gif" if gif_path else "apng", sink=outputs.write)
+        outputs.commit()
+    if pixels and not trace_path:
+        click.echo(trace_buf.getvalue(), nl=False)
     nan = result.stats.nan_rays
     if nan:
         click.echo(f"rend3r: warning: {nan} rays met NaN or infinity and were counted as misses "

@@ -37,7 +37,7 @@ def check_octree(tree: Octree) -> int:
     total = len(words)
     if total == 0:
         raise OctreeError(0, "the octree holds no words (a root node is required)")
-    uses = np.zeros(total, dtype=np.uint8)  # how often each word is claimed (saturating)
+    uses = np.full(total, -1, dtype=np.int32)  # per word: -1 unclaimed, else its claim's stamp
     addr = np.zeros(1, dtype=np.int64)
     leaves = 0
     for level in range(tree.depth):
@@ -69,7 +69,7 @@ def check_octree(tree: Octree) -> int:
             raise OctreeError(int(addr[0]), f"level {level + 1} claims {n_children} nodes; the file holds {total} words")
         starts = np.cumsum(count) - count
         addr = np.repeat(table, count) + (np.arange(n_children) - np.repeat(starts, count))
-    unused = np.flatnonzero(uses == 0)
+    unused = np.flatnonzero(uses < 0)
     if len(unused):
         raise OctreeError(int(unused[0]), "word is not part of the tree (or the tree is cut short)")
     return leaves
@@ -82,13 +82,16 @@ def _require(addr: np.ndarray, bad: np.ndarray, message: str) -> None:
 
 
 def _claim(uses: np.ndarray, index: np.ndarray) -> None:
-    """Count one use of each word in ``index``; a word claimed twice is a fault."""
-    if len(index) > 1:
-        order = np.sort(index)
-        dup = order[1:][order[1:] == order[:-1]]
-        if len(dup):
-            raise OctreeError(int(dup[0]), "word is reached twice (shared or cyclic pointers)")
-    already = uses[index] != 0
+    """Claim the words in ``index``; a word claimed twice (now or before) is a fault.
+
+    Each claim writes its position in ``index``; a position that does not read back was
+    overwritten by a later duplicate (linear time, no sort).
+    """
+    already = uses[index] >= 0
     if already.any():
         raise OctreeError(int(index[np.argmax(already)]), "word is reached twice (shared or cyclic pointers)")
-    uses[index] = 1
+    stamp = np.arange(len(index), dtype=np.int32)
+    uses[index] = stamp
+    dup = uses[index] != stamp
+    if dup.any():
+        raise OctreeError(int(index[np.argmax(dup)]), "word is reached twice (shared or cyclic pointers)")

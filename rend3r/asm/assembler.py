@@ -53,6 +53,9 @@ MAX_SOURCE = 32 << 20
 #: Lines and bytes read in one run, counting every file each time it is (re)read.
 MAX_LINES = 1 << 22
 MAX_READ = 64 << 20
+#: Characters the full grammar may parse in one run (lines the fast path does not take,
+#: each time they are read): Lark takes about 10 us a character at worst.
+MAX_PARSED = 2 << 20
 #: Characters of one line (C's translation limit is 4,095): keeps the worst line (a
 #: few thousand tokens for the full parser) well under a second.
 MAX_LINE = 4_096
@@ -204,6 +207,7 @@ class Assembler:
         self.include_depth = 0
         self.statements = 0
         self.lines_read = 0
+        self.parsed = 0  # characters sent to the full grammar
         self.bytes_read = 0
         self.rept_depth = 0  # .rept blocks running
         self.max_errors = max_errors
@@ -293,6 +297,11 @@ class Assembler:
                     body.append(_Fixed(mnemonic, words, loc, line))
                 continue
             self.where = (file, lineno, line, context)
+            self.parsed += len(line)
+            if self.parsed > MAX_PARSED:
+                self.error(f"sources too complex: more than {MAX_PARSED:,} characters of lines that need the full "
+                           "parser (expressions, directives, errors)")
+                raise _Abort
             stmt = parse_instruction(line) if fast else None
             if stmt is None:
                 try:

@@ -147,3 +147,10 @@ def test_dev_zero_in_a_real_process():
     p = subprocess.run([sys.executable, "-m", "rend3r", "asm", "/dev/zero"], capture_output=True, timeout=120)
     assert p.returncode == 1 and b"larger than the limit of 33,554,432 bytes" in p.stderr
     assert b"Traceback" not in p.stderr
+
+
+def test_full_parser_work_is_capped(tmp_path: Path, monkeypatch):
+    monkeypatch.setattr(assembler, "MAX_PARSED", 10_000)
+    (tmp_path / "c.inc").write_text("A = 1 + 2 ; a constant\n" * 10)
+    _fails_with(tmp_path, '.rept 100\n.include "c.inc"\n.endr\ner\ner\n', "sources too complex: more than 10,000")
+    _fails_with(tmp_path, "cam xloc, 1 +\n" * 1000 + "er\ner\n", "sources too complex", "--max-errors", "0")

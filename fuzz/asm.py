@@ -98,6 +98,7 @@ def limits() -> list[tuple[str, str]]:
         ("cap_nr", ".rept 1048575\nnr\n.endr\ner\ner\n"),
         ("cap_sp", ".rept 1048575, i\nsp i, xloc, yloc, i * 0.001, 1\n.endr\ner\ner\n"),
         ("cap_expr", ".rept 1048575, i\nA = " + "+".join(["i"] * 100) + "\n.endr\ner\ner\n"),
+        ("cap_parsed", (".word " + "1," * 2044 + "1\n") * 520),
         ("cap_include", '.rept 1048575\n.include "consts.inc"\n.endr\ner\ner\n'),
     ]
 

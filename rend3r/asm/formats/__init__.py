@@ -89,7 +89,9 @@ def render(fmt: str, program: Program, byteorder: str = "big", *, ihex_record_by
     return render_lst(program)
 
 
-_LST_ROW = re.compile(r"^(?:(?!//)[^|\n])*\|\s*[0-9A-Fa-f]+\s*\|", re.M)
+#: A row shaped ``... | HEX |``; the text before the first ``|`` is checked for ``//``
+#: apart (a lookahead inside the repetition would cost memory per character).
+_LST_ROW = re.compile(r"^([^|\n]*)\|\s*[0-9A-Fa-f]+\s*\|", re.M)
 _COE_KEY = re.compile(r"memory_initialization_(?:radix|vector)\s*=", re.I)
 
 
@@ -110,7 +112,7 @@ def detect_format(data: bytes, name: str | None = None) -> str:
         return "ihex"
     if _COE_KEY.search(text):
         return "coe"
-    if _LST_ROW.search(text) and not text.startswith(("//", "/*"), first):
+    if not text.startswith(("//", "/*"), first) and any("//" not in m.group(1) for m in _LST_ROW.finditer(text)):
         return "lst"
     return "mem"
 

@@ -51,6 +51,9 @@ _HEX = re.compile(r"[0-9A-Fa-f]+")
 #: A well-formed row (the common case); anything else goes through the checks that
 #: find the position of the problem.
 _ROW = re.compile(r"[^|]*\|\s*([0-9A-Fa-f]+)\s*\|((?:\s*[0-9A-Fa-f]{1,8}(?![0-9A-Fa-f]))*\s*)(?:\||$)")
+#: Longer lines skip ``_ROW``, whose repetition would hold state per word of the line.
+_FAST_ROW = 1024
+_TOKEN = re.compile(r"\S+")
 
 
 def read_lst(data: bytes, name: str) -> list[int]:
@@ -61,7 +64,7 @@ def read_lst(data: bytes, name: str) -> list[int]:
         stripped = line.strip()
         if not stripped or stripped.startswith(";"):
             continue
-        m = _ROW.match(line)
+        m = _ROW.match(line) if len(line) <= _FAST_ROW else None
         if m and int(m.group(1), 16) == len(words):
             words.extend(int(w, 16) for w in m.group(2).split())
             if len(words) > MAX_WORDS:
@@ -77,16 +80,13 @@ def read_lst(data: bytes, name: str) -> list[int]:
             raise src.error(addr_pos, "missing address")
         if address != len(words):
             raise src.error(addr_pos, f"address {shown(f'{address:x}')} out of sequence (expected {len(words):x})")
-        offset = 0
-        for token in cells[2].split():
-            offset = cells[2].index(token, offset)
-            value = _hex_cell(src, token, words_pos + offset, "word") or 0
+        for t in _TOKEN.finditer(cells[2]):
+            value = _hex_cell(src, t.group(), words_pos + t.start(), "word") or 0
             if value >= WORD_LIMIT:
-                raise src.error(words_pos + offset, f"word {shown(token)} is over 32 bits")
+                raise src.error(words_pos + t.start(), f"word {shown(t.group())} is over 32 bits")
+            if len(words) == MAX_WORDS:
+                raise src.error(words_pos + t.start(), f"more than {MAX_WORDS:,} words")
             words.append(value)
-            offset += len(token)
-        if len(words) > MAX_WORDS:
-            raise src.error(pos, f"more than {MAX_WORDS:,} words")
     if not words:
         raise src.error(0, "no words in listing")
     return words

@@ -17,9 +17,9 @@ from rend3r.errors import Rend3rError
 CHILD_MEMORY = 2 << 30  # the old readers needed 3.7-4.2 GB for these inputs
 
 
-def rend3r(*args: str, stdin=subprocess.DEVNULL, cwd=None) -> subprocess.CompletedProcess[str]:
+def rend3r(*args: str, stdin=subprocess.DEVNULL, cwd=None, memory: int = CHILD_MEMORY) -> subprocess.CompletedProcess[str]:
     def limit() -> None:
-        resource.setrlimit(resource.RLIMIT_AS, (CHILD_MEMORY, CHILD_MEMORY))
+        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
 
     return subprocess.run([sys.executable, "-m", "rend3r", *args], stdin=stdin, cwd=cwd, capture_output=True,
                           text=True, timeout=60, preexec_fn=limit)
@@ -105,3 +105,14 @@ def test_one_word_past_the_limit_is_refused():
         read_words(f"@{MAX_WORDS + 1:x} 1\n".encode(), "mem", "x")
     with pytest.raises(Rend3rError, match=r"^x:1:9: more than 1,048,576 words$"):
         read_words(f"@{MAX_WORDS:x} 1\n".encode(), "mem", "x")
+
+
+def test_one_long_line_costs_no_memory_per_character(tmp_path):
+    """Detection and the listing's row pattern once held regex state per character or word."""
+    (tmp_path / "zero.hex").write_bytes(b"0" * (40 << 20))  # detected as mem: one word, 0
+    (tmp_path / "row.lst").write_bytes(b"  | 0 | " + b"1 " * (MAX_WORDS + 1) + b"\n")
+    done = rend3r("disasm", "zero.hex", cwd=tmp_path, memory=1 << 30)
+    assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr
+    assert done.stdout.splitlines()[1:] == ["er"]
+    assert_error(rend3r("disasm", "row.lst", cwd=tmp_path, memory=1 << 30),
+                 f"row.lst:1:{8 + 2 * MAX_WORDS + 1}: more than 1,048,576 words")

@@ -31,7 +31,7 @@ class Outputs:
         """Check now that ``path`` can be written: named once, not a folder, its folder
         existing (or creatable when ``make_parents``) and writable. Rend3rError otherwise."""
         p = Path(path)
-        key = os.path.abspath(p)
+        key = os.path.abspath(p)  # no file system access: safe before the checks
         if key in self._reserved:
             raise Rend3rError(f"{p}: named by two outputs of this run")
         try:
@@ -43,6 +43,8 @@ class Outputs:
 
     @staticmethod
     def _check(p: Path, make_parents: bool) -> None:
+        if "\0" in str(p):
+            raise Rend3rError(f"{str(p)!r}: cannot write: a file name cannot hold a NUL byte")
         folder = p.parent
         while make_parents and folder != folder.parent and not folder.exists():
             folder = folder.parent

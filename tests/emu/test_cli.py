@@ -131,3 +131,62 @@ def test_program_without_nf(tmp_path):
 def test_help_shows_an_example():
     r = _run("--help")
     assert r.exit_code == 0 and "rend3r emulate programs/sphere.asm -o sphere.png" in r.output
+
+
+# --- hypothesis: emulate's command-line values (fixed budget) ---
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from rend3r.cliutil import parse_size  # noqa: E402
+
+SMALL = st.integers(0, 40).map(str)
+HUGE = st.sampled_from(["8193", "99999999999999999999", "1" * 5000, "-1", "0x10", "1e3", "１２", ""])
+PUNCT = st.sampled_from(list("{}[]:!.,x/\\ %~$*"))
+SIZES = st.one_of(st.builds(lambda w, s, h: w + s + h, SMALL | HUGE, st.sampled_from(["x", "X", " x ", ",", ""]),
+                            SMALL | HUGE), st.text(max_size=12))
+PATTERNS = st.lists(st.sampled_from(["f", "_", "{n}", "{n:03}", "{n:032}", "{n:033}", "{n[0]}", "{n:999999999}",
+                                     "{}", "{0}", "{{", "}}", "{n!r}", "{n:>9}", "{n.real}", "{", "}", "sub/", "..",
+                                     "f" * 120, "\x00", "é"]) | PUNCT, min_size=1, max_size=6).map("".join)
+PIXELS = st.builds(lambda x, s, y: x + s + y, SMALL | HUGE, st.sampled_from([",", ";", ", ", ",,"]), SMALL | HUGE)
+COLOURS = st.one_of(st.integers(-5, 0x1FFFF).map(hex), st.text(max_size=8), HUGE)
+
+
+def _small_enough(size: str) -> bool:
+    try:
+        w, h = parse_size(size)
+    except ValueError:
+        return True  # refused before any work
+    return w * h <= 4096
+
+
+OPTIONS = {"--size": SIZES, "-o": PATTERNS, "--depth-image": PATTERNS, "--provenance": PATTERNS,
+           "--trace-pixel": PIXELS, "--background": COLOURS}
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data(), which=st.sampled_from(sorted(OPTIONS)))
+def test_fuzz_option_values_exit_0_1_or_2_and_leave_nothing_on_failure(tmp_path, data, which):
+    """One option takes a hostile value, the others a valid one."""
+    value = data.draw(OPTIONS[which])
+    src = tmp_path / "s.asm"
+    src.write_text(SRC)
+    out = tmp_path / "out"
+    out.mkdir(exist_ok=True)
+    for old in sorted(out.rglob("*"), reverse=True):
+        old.unlink() if old.is_file() else old.rmdir()
+    if which in ("-o", "--depth-image", "--provenance"):
+        value = f"{out}/{value}{'.npy' if which == '--depth-image' else '.png'}"
+    if which == "--size" and not _small_enough(value):
+        value = "8x6"
+    given_ = {"-o": f"{out}/f.png", "--size": "8x6", "--trace-pixel": "1,1", "--background": "0x001F", which: value}
+    args = [x for opt, v in given_.items() for x in (opt, v)]
+    r = _run(src, *args, "--trace", out / "t.jsonl", "--frames", 1)
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    assert r.exit_code in (0, 1, 2)
+    written = [p for p in out.rglob("*") if p.is_file()]
+    if r.exit_code:
+        assert "rend3r: error: " in r.output or "Error: " in r.output, r.output
+        assert written == [] and list(out.iterdir()) == [], written
+    else:
+        assert len(written) >= 2 and not [p for p in written if p.name.startswith(".rend3r-")]

@@ -1,5 +1,7 @@
 """trace-diff on files that are not traces: exit 2 (trouble), never a traceback."""
 
+import json
+
 import pytest
 from click.testing import CliRunner
 
@@ -89,3 +91,89 @@ def test_files_over_the_limit_and_endless_streams_are_refused(tmp_path):
 def test_lines_split_only_at_newlines(tmp_path):
     line = LINE.replace('"t"', '"t\u2028u"')  # a raw U+2028 is valid inside a JSON string
     assert _diff(tmp_path, line, line).exit_code == 0
+
+
+# --- hypothesis: mutated real traces, deep nesting, huge numbers, wrong types (fixed budget) ---
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+SCENE = """nr
+cam hfov, 0.3
+cam vfov, 0.3
+lt 0, src, 1
+lt 0, zfor, -1
+sp 0, type, col, 1, 0xF800
+sp 0, zloc, rrot, -3, 1
+sp 0, xscl, yscl, 1, 1
+sp 0, zscl, zero, 1, 0
+nf
+er
+er
+"""
+
+
+@pytest.fixture(scope="module")
+def real_trace(tmp_path_factory):
+    d = tmp_path_factory.mktemp("trace")
+    (d / "s.asm").write_text(SCENE)
+    r = CliRunner().invoke(main, ["emulate", str(d / "s.asm"), "-o", str(d / "f.png"), "--size", "16x12",
+                                  "--trace-pixel", "8,6", "--trace-pixel", "0,0", "--trace", str(d / "t.jsonl")])
+    assert r.exit_code == 0, r.output
+    return (d / "t.jsonl").read_text()
+
+
+JSON_VALUES = st.recursive(
+    st.none() | st.booleans() | st.integers(-10**30, 10**30) | st.floats(allow_nan=True) | st.text(max_size=8),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=5), inner, max_size=3),
+    max_leaves=8)
+FIELDS = ("frame", "pixel", "shape", "stage", "hex", "dec")
+
+
+def _mutate(text: str, data) -> str:
+    lines = text.splitlines()
+    i = data.draw(st.integers(0, len(lines) - 1))
+    kind = data.draw(st.sampled_from(["chars", "field", "nest", "number", "splice"]))
+    if kind == "chars":
+        line = lines[i]
+        at = data.draw(st.integers(0, len(line)))
+        cut = data.draw(st.integers(0, 4))
+        lines[i] = line[:at] + data.draw(st.text(max_size=6)) + line[at + cut:]
+    elif kind == "field":
+        record = json.loads(lines[i])
+        key = data.draw(st.sampled_from(FIELDS))
+        if data.draw(st.booleans()):
+            record.pop(key, None)
+        else:
+            record[key] = data.draw(JSON_VALUES)
+        lines[i] = json.dumps(record)
+    elif kind == "nest":
+        depth = data.draw(st.integers(1, 5000))
+        lines[i] = lines[i].replace('"dec": ', '"dec": ' + "[" * depth, 1) + "]" * data.draw(st.integers(0, depth))
+    elif kind == "number":
+        digits = data.draw(st.integers(1, 6000))
+        big = data.draw(st.sampled_from(["1" * digits, "1e" + "9" * min(digits, 30), "-" + "9" * digits + ".5"]))
+        key = data.draw(st.sampled_from(["dec", "frame", "shape"]))
+        record = json.loads(lines[i])
+        record[key] = 0
+        lines[i] = json.dumps(record).replace(f'"{key}": 0', f'"{key}": {big}')
+    else:
+        lines.insert(i, lines[data.draw(st.integers(0, len(lines) - 1))][: data.draw(st.integers(0, 40))])
+    return "\n".join(lines) + "\n"
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_fuzz_mutated_traces_exit_0_1_or_2_with_a_message(tmp_path, real_trace, data):
+    mutated = _mutate(real_trace, data)
+    a, b = tmp_path / "a.jsonl", tmp_path / "b.jsonl"
+    a.write_text(real_trace)
+    b.write_text(mutated, encoding="utf-8", errors="surrogatepass")
+    for first, second in ((a, b), (b, a)):
+        r = CliRunner().invoke(main, ["trace-diff", str(first), str(second)])
+        assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+        assert r.exit_code in (0, 1, 2)
+        if r.exit_code == 2:
+            assert "rend3r: error: " in r.output and "b.jsonl:" in r.output, r.output
+        elif r.exit_code == 1:
+            assert r.output.startswith("first divergence: ")

@@ -54,8 +54,8 @@ MAX_SOURCE = 32 << 20
 MAX_LINES = 1 << 22
 MAX_READ = 64 << 20
 #: Characters the full grammar may parse in one run (lines the fast path does not take,
-#: each time they are read): Lark takes about 10 us a character at worst.
-MAX_PARSED = 2 << 20
+#: each time they are read): Lark takes up to ~50 us a character on a loaded machine.
+MAX_PARSED = 512 << 10
 #: Characters of one line (C's translation limit is 4,095): keeps the worst line (a
 #: few thousand tokens for the full parser) well under a second.
 MAX_LINE = 4_096
@@ -290,7 +290,8 @@ class Assembler:
                         self.too_large()
                     entries.append(Emitted(self.address, words, loc, line))
                     self.address += len(words)
-                    self.mnemonics.add(mnemonic)
+                    if mnemonic:  # "" for .word
+                        self.mnemonics.add(mnemonic)
                     if self.hybrid and mnemonic in PAIRS:
                         self.check_selection(mnemonic, loc, line, context)
                 else:

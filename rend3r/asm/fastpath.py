@@ -1,7 +1,8 @@
 """A regular-expression fast path for the lines most programs are made of.
 
-A line that is blank, a comment, or one instruction whose operands are plain literals
-(decimal, exponent, 0x, 0b or 0h numbers; property names) is encoded here directly,
+A line that is blank, a comment, one instruction whose operands are plain literals
+(decimal, exponent, 0x, 0b or 0h numbers; property names) or a ``.word`` of one plain
+0x or decimal literal (the disassembler's form) is encoded here directly,
 without the Lark parser. Anything else, and any line that would produce a diagnostic
 (a value out of range, a rounding warning, an SE with prop == prop2, an index beyond the
 target), returns None and goes through the full parser, which is the definition of the
@@ -47,6 +48,7 @@ _LINE = re.compile(
       | (?P<c>cam){_WS}+(?P<cp>{_NAME}){_SEP}(?P<cv>{_VAL})
       | (?P<l>lt){_WS}+(?P<li>\d{{1,7}}){_SEP}(?P<lp>{_NAME}){_SEP}(?P<lv>{_VAL})
       | (?P<s>sp|tr){_WS}+(?P<si>\d{{1,7}}){_SEP}(?P<sp>{_NAME}){_SEP}(?P<sq>{_NAME}){_SEP}(?P<sv>{_VAL}){_SEP}(?P<sw>{_VAL})
+      | (?P<w>\.word){_WS}+(?:0[xX](?P<wx>[0-9a-fA-F]{{1,8}})|(?P<wd>\d{{1,10}}))
     )?{_WS}*(?:(?://|;).*)?""",
     re.IGNORECASE | re.VERBOSE | re.ASCII,
 )
@@ -191,7 +193,7 @@ def fast_line(text: str, limits: dict[str, int] | None = None) -> tuple | None:
     m = _LINE.fullmatch(text)
     if m is None:
         return None
-    f, c, cp, cv, lt, li, lp, lv, s, si, sp, sq, sv, sw = m.groups()
+    f, c, cp, cv, lt, li, lp, lv, s, si, sp, sq, sv, sw, w, wx, wd = m.groups()
     if s:
         mn = s.lower()
         index = int(si)
@@ -221,4 +223,7 @@ def fast_line(text: str, limits: dict[str, int] | None = None) -> tuple | None:
     if f:
         mn = f.lower()
         return mn, (_F_WORDS[mn],), m.start(1) + 1
+    if w:
+        word = int(wx, 16) if wx else int(wd)
+        return None if word >> 32 else ("", (word,), m.start(15) + 1)
     return ()

@@ -167,3 +167,12 @@ def test_fast_rounding_is_exact(text):
         assert got == r.bits and not (r.overflow or r.underflow or r.relative_error > 0.01)
     else:
         assert r.overflow or r.underflow or r.relative_error > 0.0099
+
+
+@settings(max_examples=200)
+@given(st.integers(0, 1 << 33), st.sampled_from(["{:#x}", "{:#010x}", "{:d}", "{:#X}", "{:_x}"]),
+       st.sampled_from(["", " ; c", "\t// c"]))
+def test_fast_word_agrees_with_grammar(value, form, comment):
+    text = f".word {form.format(value)}{comment}\ner\ner"
+    fast, slow = assemble_source(text), assemble_source(text, fast=False)
+    assert fast.program.entries == slow.program.entries and fast.diagnostics == slow.diagnostics

@@ -6,9 +6,11 @@ every voxel a triangle touches; measured 1.45 on the bundled torus and sphere at
 5-10) plus three per unit of each triangle's longest edge (a sliver of no area still
 crosses a line of voxels), and a solid fill adds the enclosed volume (the absolute signed volume of the
 mesh, in voxels; measured within 13-26% of the fill). Peak memory is
-``BYTES_PER_VOXEL`` per voxel (the sorted keys, their coordinates and the octree
-builder's arrays; peak RSS measured 136 bytes a voxel for a depth-10 surface, 71 for a
-depth-8 solid) plus a fixed ``BASE`` (the interpreter, numpy, one voxelising batch).
+``SURFACE_BYTES`` per surface voxel (sorted Morton codes and the octree builder's
+arrays; peak RSS measured 50 bytes a voxel above the base for the torus at depth 10) and
+``FILL_BYTES`` per voxel of a solid fill (its coordinates are made before they are
+encoded; 103 measured at depth 8), plus a fixed ``BASE`` (the interpreter, numpy, one
+voxelising batch: 140 MB measured).
 """
 
 from __future__ import annotations
@@ -21,8 +23,9 @@ import numpy as np
 from ..errors import Rend3rError
 
 SURFACE_FACTOR = 1.6
-BYTES_PER_VOXEL = 150
-BASE = 128 << 20
+SURFACE_BYTES = 60
+FILL_BYTES = 100
+BASE = 160 << 20
 _UNITS = {"": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
 _SIZE = re.compile(r"\s*([0-9]+(?:\.[0-9]*)?)\s*([KMGT]?)(?:I?B)?\s*", re.IGNORECASE)
 
@@ -46,27 +49,28 @@ def default_budget() -> int:
         return 4 << 30
 
 
-def estimate_voxels(tri_grid: np.ndarray, n: int, solid: bool) -> int:
-    """Expected voxel count of triangles (m, 3, 3) given in voxel units of an n^3 grid."""
+def estimate_voxels(tri_grid: np.ndarray, n: int, solid: bool) -> tuple[int, int]:
+    """Expected (surface, solid fill) voxel counts of triangles (m, 3, 3) in voxel units of an n^3 grid."""
     a, b, c = tri_grid[:, 0], tri_grid[:, 1], tri_grid[:, 2]
     cross = np.cross(b - a, c - a)
     area = 0.5 * float(np.sqrt((cross * cross).sum(1)).sum())
     edges = np.sqrt((np.stack([b - a, c - b, a - c]) ** 2).sum(-1)).max(0)
-    count = SURFACE_FACTOR * area + 3.0 * float(edges.sum())  # slivers cover their length
-    if solid:
-        count += abs(float((cross * a).sum())) / 6.0
-    return int(min(count, float(n) ** 3))
+    surface = SURFACE_FACTOR * area + 3.0 * float(edges.sum())  # slivers cover their length
+    fill = abs(float((cross * a).sum())) / 6.0 if solid else 0.0
+    cap = float(n) ** 3
+    return int(min(surface, cap)), int(min(fill, cap))
 
 
-def check_budget(voxels: int, budget: int, what: str) -> None:
-    """Refuse, with the estimate, a build of ``voxels`` voxels that would exceed ``budget`` bytes."""
-    need = BASE + BYTES_PER_VOXEL * voxels
+def check_budget(voxels: tuple[int, int], budget: int, what: str) -> None:
+    """Refuse, with the estimate, a build of (surface, fill) voxels that would exceed ``budget`` bytes."""
+    surface, fill = voxels
+    need = BASE + SURFACE_BYTES * surface + FILL_BYTES * fill
     if need > budget:
-        raise Rend3rError(f"{what}: about {voxels:,} voxels need an estimated {need / 2**30:.1f} GiB, "
+        raise Rend3rError(f"{what}: about {surface + fill:,} voxels need an estimated {need / 2**30:.1f} GiB, "
                           f"over the memory budget of {budget / 2**30:.1f} GiB (--max-memory; "
                           "use a smaller --depth)")
 
 
-def max_voxels(budget: int) -> int:
-    """Most voxels a build may hold within ``budget`` bytes."""
-    return max((budget - BASE) // BYTES_PER_VOXEL, 0)
+def max_voxels(budget: int, per_voxel: int = SURFACE_BYTES) -> int:
+    """Most voxels a build may hold within ``budget`` bytes at ``per_voxel`` bytes each."""
+    return max((budget - BASE) // per_voxel, 0)

@@ -89,7 +89,7 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
     """
     import numpy as np
 
-    from .budget import check_budget, default_budget, max_voxels
+    from .budget import FILL_BYTES, check_budget, default_budget, max_voxels
     from .fileformat import SvoModel, encode_svo
     from .mesh_io import encode_binvox, read_binvox, read_mesh
     from .octree import build_octree_codes, morton_decode, morton_encode
@@ -99,7 +99,7 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
     budget = max_memory or default_budget()
     start = time.perf_counter()
     if Path(mesh).suffix.lower() == ".binvox":
-        coords, dim, translate, scale = read_binvox(mesh, max_voxels(budget))
+        coords, dim, translate, scale = read_binvox(mesh, max_voxels(budget, FILL_BYTES))
         need = max(int(np.ceil(np.log2(dim))), 1)
         if depth is not None and depth != need:
             raise Rend3rError(f"{mesh}: a {dim}^3 binvox grid needs --depth {need}")
@@ -111,7 +111,7 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
         if not (np.all(np.isfinite(lo)) and np.isfinite(h) and h > 0
                 and np.all(np.isfinite(lo + h * (1 << depth)))):
             raise Rend3rError(f"{mesh}: binvox translate and scale must be finite, scale positive")
-        check_budget(len(coords), budget, mesh)
+        check_budget((0, len(coords)), budget, mesh)
         codes = np.unique(morton_encode(coords, depth))
         del coords
     else:

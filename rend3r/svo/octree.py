@@ -77,9 +77,21 @@ class Octree:
     def far_count(self) -> int:
         """Number of nodes whose child-table pointer goes through a far slot.
 
-        Far slots hold arbitrary data, so nodes are found by walking the tree.
+        Far slots hold arbitrary data, so nodes are found by walking the tree, one array
+        of node addresses per level (not one row of eight children per node).
         """
-        return int(sum(int(far.sum()) for far, _ in _walk_levels(self)))
+        words = self.words
+        addr = np.zeros(1, dtype=np.int64)
+        far = 0
+        for _ in range(self.depth - 1):
+            w = words[addr].astype(np.int64)
+            inner = ((w >> 8) & 0xFF) & ~(w & 0xFF)
+            far += int((((w >> 16) & 1) == 1)[inner != 0].sum())
+            table, _ = child_table(words, addr)
+            count = popcount8(inner)
+            starts = np.cumsum(count) - count
+            addr = np.repeat(table, count) + (np.arange(int(count.sum())) - np.repeat(starts, count))
+        return far
 
 
 def _level_nodes(codes: np.ndarray, depth: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:

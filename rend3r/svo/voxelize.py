@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import Rend3rError
-from .budget import check_budget, estimate_voxels
+from .budget import FILL_BYTES, SURFACE_BYTES, check_budget, estimate_voxels
 from .budget import max_voxels as voxel_limit
 from .octree import morton_decode, morton_encode
 
@@ -266,6 +266,7 @@ def voxelize_codes(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool
     if len(codes) == 0:
         raise Rend3rError("mesh has no area: every triangle has equal or collinear vertices")
     if solid:
-        fill = fill_solid(tri, n, None if limit is None else max(limit - len(codes), 0))
+        room = None if budget is None else voxel_limit(budget - SURFACE_BYTES * len(codes), FILL_BYTES)
+        fill = fill_solid(tri, n, room)
         codes = np.union1d(codes, morton_encode(fill, depth))
     return codes, lo, h

@@ -59,6 +59,8 @@ MAX_DIGITS = 24
 #: Longest stage name (the emulator's longest is under 20 characters).
 MAX_STAGE = 200
 _HEX = re.compile(r"-?0[xX][0-9a-fA-F]{1,%d}" % MAX_DIGITS, re.ASCII)
+#: A line that is not blank (lines end at newlines only; U+2028 may sit inside a string).
+_LINE = re.compile(r"^[^\S\n]*+\S[^\n]*", re.MULTILINE)
 _BRACKETS = re.compile(r'"(?:[^"\\]|\\.)*"?|[\[\]{}]')
 
 
@@ -143,9 +145,12 @@ def read_trace(path: Path) -> list[Record]:
         line = data[: exc.start].count(b"\n") + 1
         raise Rend3rError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x}): not a trace") from None
     del data
-    return [
-        parse_record(line, f"{path}:{n}", n) for n, line in enumerate(text.split("\n"), 1) if line.strip()
-    ]
+    records, line, last = [], 1, 0
+    for m in _LINE.finditer(text):
+        line += text.count("\n", last, m.start())
+        last = m.start()
+        records.append(parse_record(m[0], f"{path}:{line}", line))
+    return records
 
 
 def _keyed(records: list[Record]) -> dict[Key, Record]:

@@ -55,7 +55,7 @@ MAX_LINES = 1 << 22
 MAX_READ = 64 << 20
 #: Characters the full grammar may parse in one run (lines the fast path does not take,
 #: each time they are read): Lark takes up to ~50 us a character on a loaded machine.
-MAX_PARSED = 512 << 10
+MAX_PARSED = 256 << 10
 #: Characters of one line (C's translation limit is 4,095): keeps the worst line (a
 #: few thousand tokens for the full parser) well under a second.
 MAX_LINE = 4_096

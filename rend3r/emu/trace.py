@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from typing import Callable, Iterable
 
 import numpy as np
@@ -47,13 +48,16 @@ class _Writer:
         self.emit({"frame": self.frame, "pixel": list(self.pixel), "shape": shape, "stage": stage, "hex": hx, "dec": dec})
 
 
+_PIXEL = re.compile(r"\s*(-?[0-9]{1,9})\s*,\s*(-?[0-9]{1,9})\s*", re.ASCII)
+
+
 def parse_pixel(text: str) -> tuple[int, int]:
-    """``"X,Y"`` -> (x, y)."""
-    try:
-        x, y = (int(v) for v in text.split(","))
-    except ValueError:
-        raise ValueError(f"expected X,Y such as 252,188, not {text!r}") from None
-    return x, y
+    """``"X,Y"`` -> (x, y): decimal integers of at most 9 digits (the frame's range is checked later)."""
+    m = _PIXEL.fullmatch(text)
+    if not m:
+        shown = text if len(text) <= 40 else text[:37] + "..."
+        raise ValueError(f"expected X,Y such as 252,188, not {shown!r}")
+    return int(m[1]), int(m[2])
 
 
 _SHAPE_STAGES = ("origin.x", "origin.y", "origin.z", "dir.x", "dir.y", "dir.z", "a2", "b", "c2", "disc", "sqrt",

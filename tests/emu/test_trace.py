@@ -86,3 +86,15 @@ def test_records_parse_with_the_diff_reader_and_self_compare_equal():
         assert set(r) == {"frame", "pixel", "shape", "stage", "hex", "dec"}
         if r["hex"].startswith("0x") and len(r["hex"]) == 6 and isinstance(r["dec"], float):
             assert np.array(int(r["hex"], 16), np.uint16).view(np.float16) == np.float16(r["dec"])
+
+
+def test_parse_pixel_takes_bounded_decimal_pairs_only():
+    import pytest
+
+    from rend3r.emu.trace import parse_pixel
+
+    assert parse_pixel(" 252 , 188 ") == (252, 188) and parse_pixel("-1,5") == (-1, 5)
+    for bad in ("1;2", "1,2,3", "", "1" * 5000 + ",1", "١٢,3", "0x10,1", "1e3,1"):
+        with pytest.raises(ValueError, match="expected X,Y") as info:
+            parse_pixel(bad)
+        assert len(str(info.value)) < 100

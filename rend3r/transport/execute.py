@@ -34,6 +34,10 @@ def parse_size(text: str) -> tuple[int, int]:
         raise Rend3rError(f"malformed size: {exc}") from None
 
 
+#: A program starts rendering once no newer one has arrived for this long (seconds).
+SETTLE = 0.05
+
+
 class _Superseded(Exception):
     """Raised inside the emulator's callbacks to abandon a run that was replaced or stopped."""
 
@@ -56,7 +60,8 @@ class RenderExecutor:
 
     One worker thread renders at a time. :meth:`start` leaves the program in a one-slot
     mailbox (a newer one replaces a program not yet begun) and cancels the running render,
-    which stops at its next band, frame-rate wait or PNG band. So however fast commits
+    which stops at its next band, frame-rate wait or PNG band; a program starts once no
+    newer one has come for :data:`SETTLE` seconds. So however fast commits
     arrive, one render is in flight, its memory is one frame's, and the program rendered
     last is the one committed last. Frames go to ``run{N:04d}_frame{F:04d}.png`` where N
     counts :meth:`start` calls: runs superseded before they began leave no files.
@@ -112,14 +117,29 @@ class RenderExecutor:
     def _work(self) -> None:
         while True:
             with self._cond:
-                while self._pending is None and not self._closed:
-                    self._cond.wait()
+                if not self._settled():
+                    continue
                 if self._closed:
                     return
                 (words, run), self._pending = self._pending, None
                 self._cancel.clear()
                 self.rendered[:] = [*self.rendered[-15:], run]
             self._run(words, run)
+
+    def _settled(self) -> bool:
+        """Wait (holding the lock) for a program that no newer one replaced within SETTLE
+        seconds; False if the mailbox was emptied meanwhile (stop). Under a commit storm the
+        worker then stays idle, leaving the processor to the link, and renders the last one."""
+        while self._pending is None and not self._closed:
+            self._cond.wait()
+        while not self._closed:
+            run = self._pending[1]
+            self._cond.wait(SETTLE)
+            if self._pending is None:
+                return False
+            if self._pending[1] == run:
+                return True
+        return True
 
     def _check(self) -> None:
         if self._cancel.is_set():

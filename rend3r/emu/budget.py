@@ -35,9 +35,10 @@ def estimate_memory(mode: str, width: int, height: int, frames: int, outputs: li
         ext = animation[animation.rfind("."):].lower()
         kept = ANIMATION.get(ext, max(ANIMATION.values())) * pixels * frames
     need = BASE + max(engine, encode) + kept
-    parts = f"renderer {engine / 2**30:.2f} GiB"
+    parts = f"interpreter {BASE / 2**30:.2f} GiB + renderer {engine / 2**30:.2f} GiB"
     if outputs:
-        parts += f", encoding {encode / 2**30:.2f} GiB"
+        parts = f"interpreter {BASE / 2**30:.2f} GiB + the larger of renderer {engine / 2**30:.2f} GiB " \
+                f"and encoding {encode / 2**30:.2f} GiB"
     if kept:
-        parts += f", {frames} animation frames {kept / 2**30:.2f} GiB"
+        parts += f" + {frames} animation frames {kept / 2**30:.2f} GiB"
     return need, parts

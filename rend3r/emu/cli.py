@@ -125,7 +125,7 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
                                   [p for p in (output, depth_path, prov_path) if p], animate)
     if need > budget:
         raise Rend3rError(f"a {options.width}x{options.height} {options.mode} run with these outputs needs about "
-                          f"{need / 2**30:.1f} GiB ({parts}); the memory budget is {budget / 2**30:.1f} GiB "
+                          f"{need / 2**30:.2f} GiB ({parts}); the memory budget is {budget / 2**30:.2f} GiB "
                           f"(--max-memory): render fewer pixels or frames, or raise the budget")
     outputs = Outputs()
     for path in (output, depth_path, prov_path):

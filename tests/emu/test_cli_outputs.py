@@ -151,7 +151,7 @@ def test_a_name_too_long_is_refused_before_rendering(tmp_path):
 
 def test_a_run_over_the_memory_budget_is_refused_with_its_estimate(tmp_path):
     r = _run(_anim(tmp_path), "--gif", tmp_path / "a.gif", "--size", "8192x8192", "--max-memory", "2G")
-    assert r.exit_code == 1 and "memory budget is 2.0 GiB" in r.output and "3 animation frames" in r.output, r.output
+    assert r.exit_code == 1 and "memory budget is 2.00 GiB" in r.output and "3 animation frames" in r.output, r.output
     assert "needs about" in r.output and "--max-memory" in r.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["anim.asm"]
     r = _run(_anim(tmp_path), "--gif", tmp_path / "a.gif", "--size", "8x6", "--max-memory", "2x")

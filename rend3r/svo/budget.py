@@ -7,7 +7,7 @@ every voxel a triangle touches; measured 1.45 on the bundled torus and sphere at
 crosses a line of voxels), and a solid fill adds the enclosed volume (the absolute signed volume of the
 mesh, in voxels; measured within 13-26% of the fill). Peak memory is
 ``SURFACE_BYTES`` per surface voxel (sorted Morton codes and the octree builder's
-arrays; peak RSS measured 50 bytes a voxel above the base for the torus at depth 10) and
+arrays; peak RSS measured 50-79 bytes a voxel above the base for the torus at depths 10-11) and
 ``FILL_BYTES`` per voxel of a solid fill (its coordinates are made before they are
 encoded; 103 measured at depth 8), plus a fixed ``BASE`` (the interpreter, numpy, one
 voxelising batch: 140 MB measured).
@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import Rend3rError
 
 SURFACE_FACTOR = 1.6
-SURFACE_BYTES = 60
+SURFACE_BYTES = 80
 FILL_BYTES = 100
 BASE = 160 << 20
 _UNITS = {"": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}

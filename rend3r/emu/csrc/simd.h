@@ -36,16 +36,27 @@ typedef int32_t i32x4 __attribute__((vector_size(16)));
  * integer rounding of the significand; overflow to infinity; NaN kept; below 2**-14
  * flushed (ftz; 2**-14 - 2**-25 and up go to 2**-14) or rounded to the subnormal grid
  * (adding and subtracting 2**23 rounds to an integer, nearest even). */
+static __attribute__((noinline)) f32x8 round16x8_rare(f32x8 x, int ftz);
+
 INLINE f32x8 round16x8(f32x8 x, int ftz)
 {
-    u32x8 b = (u32x8)x, a = b & 0x7FFFFFFFu, sign = b & 0x80000000u;
+    u32x8 b = (u32x8)x, a = b & 0x7FFFFFFFu;
     u32x8 normal = (u32x8)((a >= 0x38800000u) & (a < 0x477FF000u));
-    u32x8 r = (b + 0xFFFu + ((b >> 13) & 1u)) & 0xFFFFE000u;
     int all = 1;
     for (int i = 0; i < 8; i++)
         all &= normal[i] != 0;
     if (all)
-        return (f32x8)r;
+        return (f32x8)((b + 0xFFFu + ((b >> 13) & 1u)) & 0xFFFFE000u);
+    return round16x8_rare(x, ftz);
+}
+
+/* round16x8 for packets with a lane that is zero, subnormal, overflowing or not finite:
+ * out of line, so that the hundreds of roundings of a kernel stay small to compile. */
+static f32x8 round16x8_rare(f32x8 x, int ftz)
+{
+    u32x8 b = (u32x8)x, a = b & 0x7FFFFFFFu, sign = b & 0x80000000u;
+    u32x8 normal = (u32x8)((a >= 0x38800000u) & (a < 0x477FF000u));
+    u32x8 r = (b + 0xFFFu + ((b >> 13) & 1u)) & 0xFFFFE000u;
     u32x8 big = SEL_BITS((u32x8)(a > 0x7F800000u), b, sign | 0x7F800000u), small;
     if (ftz) {
         small = SEL_BITS((u32x8)(a < 0x387FE000u), sign, sign | 0x38800000u);

@@ -27,7 +27,7 @@ import numpy as np
 import walls
 
 from rend3r.emu.options import EmuOptions
-from rend3r.emu.raytracer import available_cores
+from rend3r.emu.threads import available_cores
 from rend3r.emu.run import RunResult, run_program
 from rend3r.memory import reuse_freed_memory
 

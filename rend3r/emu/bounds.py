@@ -12,37 +12,48 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import native
+from . import native, threads
 
 SLACK = 1e-9
+#: Shapes a thread takes at least.
+SHAPE_CHUNK = 1 << 12
 
 
 def cull_radii(table: np.ndarray, ok: np.ndarray, dist: np.ndarray, dmin: float, u: float, tiny: float,
-               fp16: bool) -> np.ndarray:
+               fp16: bool, jobs: int = 1) -> np.ndarray:
     """Per shape, the world radius beyond which no ray line can hit (inf: no bound): rays
     whose origins lie within ``dist`` (per shape) of the centre, directions at least
     ``dmin`` long, unit roundoff ``u`` and smallest normal ``tiny`` of the precision."""
     out = np.empty(len(table))
-    flags = np.ascontiguousarray(ok, np.uint8)
-    dist = np.ascontiguousarray(dist, np.float64)
-    native.library().bound_radii(native.ptr(table, np.float64, (len(out), native.B_COLUMNS)), flags.ctypes.data,
-                                 native.ptr(dist, np.float64, (len(out),)), len(out), dmin, u, tiny, int(fp16),
-                                 out.ctypes.data)
+    table, flags, dist = _inputs(table, ok, dist)
+    lib = native.library()
+    threads.split(jobs, len(out), SHAPE_CHUNK, lambda a, b: lib.bound_radii(
+        table[a:].ctypes.data, flags[a:].ctypes.data, dist[a:].ctypes.data, b - a, dmin, u, tiny, int(fp16),
+        out[a:].ctypes.data))
     return out
 
 
 def depth_floors(table: np.ndarray, ok: np.ndarray, dist: np.ndarray, dmin: float, dmax: float, u: float,
-                 tiny: float) -> np.ndarray:
+                 tiny: float, jobs: int = 1) -> np.ndarray:
     """Per shape, a lower bound of the computed ``sq_dist`` of any hit by a ray from an apex
     ``dist`` (per shape) from the centre, directions between ``dmin`` and ``dmax`` long; 0:
     no bound claimed."""
     out = np.empty(len(table))
-    flags = np.ascontiguousarray(ok, np.uint8)
-    dist = np.ascontiguousarray(dist, np.float64)
-    native.library().bound_floors(native.ptr(table, np.float64, (len(out), native.B_COLUMNS)), flags.ctypes.data,
-                                  native.ptr(dist, np.float64, (len(out),)), len(out), dmin, dmax, u, tiny,
-                                  out.ctypes.data)
+    table, flags, dist = _inputs(table, ok, dist)
+    lib = native.library()
+    threads.split(jobs, len(out), SHAPE_CHUNK, lambda a, b: lib.bound_floors(
+        table[a:].ctypes.data, flags[a:].ctypes.data, dist[a:].ctypes.data, b - a, dmin, dmax, u, tiny,
+        out[a:].ctypes.data))
     return out
+
+
+def _inputs(table: np.ndarray, ok: np.ndarray, dist: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The per-shape inputs as the kernels read them (checked table, uint8 flags, float64)."""
+    n = len(table)
+    native.ptr(table, np.float64, (n, native.B_COLUMNS))
+    dist = np.ascontiguousarray(dist, np.float64)
+    native.ptr(dist, np.float64, (n,))
+    return table, np.ascontiguousarray(ok, np.uint8), dist
 
 
 def reach(points: np.ndarray, centers: np.ndarray) -> np.ndarray:

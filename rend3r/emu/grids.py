@@ -32,7 +32,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from . import native
+from . import native, threads
 
 RAYS_PER_CELL = 8
 #: Entries the cell lists may hold: this many per cell, within [MIN_BUDGET, MAX_BUDGET].
@@ -42,6 +42,8 @@ MAX_CELLS_PER_AXIS = 4096
 #: to MAX_BLOCK columns x rows): deep scenes list every shape behind a pixel.
 PIXEL_ENTRIES, MAX_BLOCK = 2, (64, 16)
 #: Per face: u0, u1, v0, v1, rays, shortest and longest direction (as the kernels fill it).
+#: Entries of the cell lists, and shapes, a thread takes at least.
+CELL_CHUNK, SHAPE_CHUNK = 1 << 14, 1 << 12
 EMPTY_BOXES = np.tile(np.array([np.inf, -np.inf, np.inf, -np.inf, 0.0, np.inf, -np.inf]), (3, 1))
 
 
@@ -170,16 +172,42 @@ def _sizes(rects: np.ndarray) -> np.ndarray:
 
 
 def _footprints(faces: np.ndarray, shape: np.ndarray, layout: tuple | None, parallel: bool, centers: np.ndarray,
-                radii: np.ndarray, rects: np.ndarray) -> None:
+                radii: np.ndarray, rects: np.ndarray, jobs: int) -> None:
     """Fill ``rects`` (n, 3, 4) with each shape's cell rectangle per face on a grid of
-    these face tables (csrc/kernels.c grid_footprints)."""
+    these face tables (csrc/kernels.c grid_footprints), shapes split over ``jobs`` threads."""
     empty = Grid(faces, shape, np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0, np.int32), layout)
-    native.library().grid_footprints(byref(empty.struct()), int(parallel), centers.ctypes.data, radii.ctypes.data,
-                                     len(radii), rects.ctypes.data)
+    view, lib = empty.struct(), native.library()
+    threads.split(jobs, len(radii), SHAPE_CHUNK, lambda a, b: lib.grid_footprints(
+        byref(view), int(parallel), centers[a:].ctypes.data, radii[a:].ctypes.data, b - a, rects[a:].ctypes.data))
+
+
+def _fill(rects: np.ndarray, shape: np.ndarray, order: np.ndarray, listed: np.ndarray, cells: int,
+          jobs: int) -> tuple[np.ndarray, np.ndarray]:
+    """The cell lists (start, entries) of the ``listed`` shapes in ``order``: each thread
+    counts, then writes, a range of ``order`` at the places the earlier ranges leave it, so
+    the lists are the same for any split (csrc/kernels.c grid_fill)."""
+    lib, flags = native.library(), listed.astype(np.uint8)
+    parts = threads.ranges(len(order), jobs, SHAPE_CHUNK)
+    counts = np.zeros((len(parts), cells), np.int64)
+
+    def run(pos: np.ndarray, entries: np.ndarray | None) -> None:
+        threads.each(jobs, [lambda t=t, a=a, b=b: lib.grid_fill(
+            rects.ctypes.data, shape.ctypes.data, order[a:].ctypes.data, b - a, flags.ctypes.data, pos[t].ctypes.data,
+            None if entries is None else entries.ctypes.data, int(entries is not None))
+            for t, (a, b) in enumerate(parts)])
+
+    run(counts, None)
+    start = np.zeros(cells + 1, np.int64)
+    np.cumsum(counts.sum(axis=0), out=start[1:])
+    pos = start[:-1] + np.cumsum(counts, axis=0) - counts  # where each range's entries of a cell begin
+    entries = np.empty(int(start[-1]), np.int32)
+    run(pos, entries)
+    return start, entries
 
 
 def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndarray, order: np.ndarray,
-          pixels: PixelLayout | None = None, rays_per_cell: int = RAYS_PER_CELL, reach: bool = False) -> Grid:
+          pixels: PixelLayout | None = None, rays_per_cell: int = RAYS_PER_CELL, reach: bool = False,
+          jobs: int = 1) -> Grid:
     """A grid over the rays' per-face ``boxes`` ((3, BOX_COLUMNS): u0, u1, v0, v1, rays, ...;
     no rays: an unused face) listing shapes: ``centers`` (n, 3) relative to the apex, or
     projected (u, v, 0) for a parallel bundle, cull ``radii``, listed in ``order``. With
@@ -187,7 +215,7 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
     ``rays_per_cell`` rays share a cell. The lists may hold a few entries per ray: coarser
     cells when they would hold more, then the largest footprints go to the global list.
     With ``reach`` (a perspective bundle), every fourth entry gets the cone of lines the
-    rest of its list may hit."""
+    rest of its list may hit. ``jobs`` threads share the per-cell work."""
     n = len(radii)
     centers = np.ascontiguousarray(centers, np.float64)
     radii = np.ascontiguousarray(radii, np.float64)
@@ -199,7 +227,7 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
     if pixels is not None:  # pixel rectangles once; blocks by integer division
         one = replace(pixels, block=1, block_rows=1)
         faces, shape, layout = _pixel_faces(one)
-        _footprints(faces, shape, layout, False, centers, radii, rects)
+        _footprints(faces, shape, layout, False, centers, radii, rects, jobs)
         px, none = rects[:, 2].copy(), rects[:, 2, 0] > rects[:, 2, 1]
         c0, c1, r0, r1 = px[(rects[:, 0, 0] >= 0) & ~none].T  # the listed shapes' pixel rectangles
         while True:  # the finest blocks whose lists stay within budget
@@ -218,7 +246,7 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
         cells = max(1.0, float(boxes[:, 4].sum()) / rays_per_cell)
         while True:
             faces, shape = _layout(boxes, cells)
-            _footprints(faces, shape, None, parallel, centers, radii, rects)
+            _footprints(faces, shape, None, parallel, centers, radii, rects, jobs)
             sizes = _sizes(rects)
             total = int(sizes[sizes >= 0].sum())
             budget = min(MAX_BUDGET, max(MIN_BUDGET, ENTRIES_PER_CELL * int((shape[:, 0] * shape[:, 1]).sum())))
@@ -232,18 +260,13 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
         left = total - np.cumsum(sizes[big])
         listed[big[: int(np.searchsorted(-left, -budget)) + 1]] = False
     n_cells = int((shape[:, 0] * shape[:, 1]).sum())
-    flags = listed.astype(np.uint8)
-    counts = np.zeros(n_cells + 1, np.int64)
-    lib.grid_fill(rects.ctypes.data, shape.ctypes.data, order.ctypes.data, n, flags.ctypes.data,
-                  counts[1:].ctypes.data, None, 0)
-    start = np.cumsum(counts)
-    entries = np.empty(int(start[-1]), np.int32)
-    pos = start[:-1].copy()
-    lib.grid_fill(rects.ctypes.data, shape.ctypes.data, order.ctypes.data, n, flags.ctypes.data, pos.ctypes.data,
-                  entries.ctypes.data, 1)
+    start, entries = _fill(rects, shape, order, listed, n_cells, jobs)
     cones = None
     if reach and not parallel:  # the lines the rest of each list may hit, for packets to stop early
         cones = np.empty(-(-len(entries) // 4) * 4, np.float32)
-        lib.cone_reach(centers.ctypes.data, radii.ctypes.data, start.ctypes.data, n_cells, entries.ctypes.data,
-                       cones.ctypes.data)
+        balls = np.empty((n, native.CONE_COLUMNS))
+        lib.cone_balls(centers.ctypes.data, radii.ctypes.data, n, balls.ctypes.data)
+        threads.split(jobs, n_cells, max(1, n_cells * CELL_CHUNK // max(1, len(entries))),
+                      lambda a, b: lib.cone_reach(balls.ctypes.data, start.ctypes.data, a, b, entries.ctypes.data,
+                                                  cones.ctypes.data))
     return Grid(faces, shape, start, entries, order[~listed[order]], layout, cones)

@@ -31,6 +31,7 @@ GF_SU, GF_SV = 4, 5  # a face's cells per unit of u and of v
 TRACE_SHAPE_VALUES, TRACE_LIGHT_VALUES = 22, 12
 OUT_TESTS, OUT_NAN_TESTS, OUT_SHADOW_RAYS, OUT_HITS, OUT_LO, OUT_HI, OUT_COLUMNS = 0, 1, 2, 3, 4, 7, 10
 PC_COLUMNS = 7
+CONE_COLUMNS = 6  # cone_balls: unit axis, half-angle, its sine and cosine
 
 
 class Shapes(Structure):
@@ -101,8 +102,10 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
 _PLAIN = {
     "grid_footprints": (None, [POINTER(Grid), c_int32, c_void_p, c_void_p, c_int64, c_void_p]),
     "grid_fill": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_int32]),
-    "behind_reach": (None, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_double, c_double, c_void_p]),
-    "cone_reach": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_void_p, c_void_p]),
+    "behind_keys": (None, [c_void_p, c_void_p, c_int64, c_double, c_double, c_void_p]),
+    "behind_reach": (None, [c_void_p, c_int64, c_int64, c_void_p, c_void_p, c_void_p]),
+    "cone_balls": (None, [c_void_p, c_void_p, c_int64, c_void_p]),
+    "cone_reach": (None, [c_void_p, c_void_p, c_int64, c_int64, c_void_p, c_void_p]),
     "bound_radii": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_int32, c_void_p]),
     "bound_floors": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double,
                             c_void_p]),

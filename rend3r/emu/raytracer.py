@@ -19,11 +19,8 @@ change a pixel; :mod:`.reference` is the plain renderer the tests compare with.
 
 from __future__ import annotations
 
-import os
-from concurrent.futures import ThreadPoolExecutor
 from ctypes import byref, pointer
 from dataclasses import dataclass
-from functools import lru_cache
 from time import perf_counter
 from typing import Callable
 
@@ -31,7 +28,7 @@ import numpy as np
 
 from ..isa import Table, lookup
 from ..isa.tables import PROP_LIMIT, SHAPE_TYPE_CODES
-from . import bounds, grids, native
+from . import bounds, grids, native, threads
 from .arith import Arith
 from .camera import camera_rays
 from .frame import Frame
@@ -46,19 +43,6 @@ BAND_PIXELS = native.BAND_LIMIT
 #: Smallest chunk of pixels handed to a thread.
 MIN_CHUNK = 1 << 12
 _CHANNELS = ((11, 31), (5, 63), (0, 31))  # RGB565: (shift, largest value) per channel
-
-
-def available_cores() -> int:
-    """Cores this process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not Linux
-        return os.cpu_count() or 1
-
-
-@lru_cache(maxsize=4)
-def _pool(jobs: int) -> ThreadPoolExecutor:
-    return ThreadPoolExecutor(max_workers=jobs, thread_name_prefix="rend3r")
 
 
 @dataclass
@@ -131,7 +115,7 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
         native.kernel("origin_terms", ar.precision, ar.ftz)(byref(view), native.ptr(cam, dtype, (native.CAM_COLUMNS,)))
     return _Frame(ar, dtype, cam, np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype),
                   rays.rotation is not None, sf, si, index, bnd, bounded, lights,
-                  _light_rows(lights, dtype), options.jobs or available_cores(), view)
+                  _light_rows(lights, dtype), options.jobs or threads.available_cores(), view)
 
 
 #: The shape table's columns the kernels read, and the type codes of the normal forms.
@@ -196,27 +180,17 @@ def _light_rows(lights: list[Light], dtype: np.dtype) -> np.ndarray:
     return rows
 
 
-def _chunks(n: int, jobs: int) -> list[tuple[int, int]]:
-    """Pixel ranges for the threads: a few per thread, so that uneven work evens out."""
-    parts = 1 if jobs == 1 else max(1, min(4 * jobs, n // MIN_CHUNK))
-    edges = [n * k // parts for k in range(parts + 1)]
-    return [(a, b) for a, b in zip(edges, edges[1:]) if b > a]
-
-
-def _run(jobs: int, n: int, fn: Callable[..., object], block: object, last: np.ndarray | int) -> np.ndarray | None:
-    """``fn(block, k0, k1, last)`` over chunks of 0..n on ``jobs`` threads. An array ``last``
-    (e.g. counters) is copied for each chunk and the copies are returned stacked; an int
-    (an address) is passed to every chunk as it is."""
-    chunks = _chunks(n, jobs)
+def _run(jobs: int, n: int, fn: Callable[..., object], block: object, last: np.ndarray | int,
+         smallest: int = MIN_CHUNK) -> np.ndarray | None:
+    """``fn(block, k0, k1, last)`` over chunks of 0..n (``smallest`` long at least) on ``jobs``
+    threads. An array ``last`` (e.g. counters) is copied for each chunk and the copies are
+    returned stacked; an int (an address) is passed to every chunk as it is."""
+    chunks = threads.ranges(n, jobs, smallest)
     copies = isinstance(last, np.ndarray)
     outs = np.stack([last.copy() for _ in chunks]) if copies else None
-    args = [(byref(block), a, b, outs[k].ctypes.data if copies else last) for k, (a, b) in enumerate(chunks)]
-    if jobs == 1 or len(chunks) == 1:
-        for arg in args:
-            fn(*arg)
-    else:
-        for future in [_pool(jobs).submit(fn, *arg) for arg in args]:
-            future.result()
+    ref = byref(block)
+    threads.each(jobs, [lambda k=k, a=a, b=b: fn(ref, a, b, outs[k].ctypes.data if copies else last)
+                        for k, (a, b) in enumerate(chunks)])
     return outs
 
 
@@ -272,7 +246,8 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, st: FrameStats,
         a["start"], a["pixels"] = _buckets(a["cells"], grid.cells + 1)
         band.bucket_start, band.bucket_pixels = a["start"].ctypes.data, a["pixels"].ctypes.data
         packets += 1
-    c = _report(_run(fr.jobs, packets, fr.kernel("nearest"), band, _OUT))
+    per_cell = n_pix / max(1, grid.cells)
+    c = _report(_run(fr.jobs, packets, fr.kernel("nearest"), band, _OUT, max(1, int(MIN_CHUNK / per_cell))))
     st.tests += int(c[native.OUT_TESTS])
     st.nan_tests += int(c[native.OUT_NAN_TESTS])
     st.skipped += n_pix * n - int(c[native.OUT_TESTS])
@@ -317,13 +292,13 @@ def _primary_grid(fr: _Frame, boxes: np.ndarray,
         centers = fr.bnd[:, :3] - apex
         dist = np.linalg.norm(centers, axis=1)
     u, tiny = fr.ar.unit_roundoff, fr.ar.tiny
-    radius = bounds.cull_radii(fr.bnd, bounded, dist, dmin, u, tiny, fr.fp16)
-    floor = bounds.depth_floors(fr.bnd, bounded, dist, dmin, dmax, u, tiny)
+    radius = bounds.cull_radii(fr.bnd, bounded, dist, dmin, u, tiny, fr.fp16, fr.jobs)
+    floor = bounds.depth_floors(fr.bnd, bounded, dist, dmin, dmax, u, tiny, fr.jobs)
     pc = np.empty((len(radius), native.PC_COLUMNS))
     native.library().bound_primary(fr.bnd.ctypes.data, radius.ctypes.data, len(radius), apex.ctypes.data, dmin, u,
                                    tiny, pc.ctypes.data)
     order = np.argsort(floor, kind="stable").astype(np.int32)
-    return grids.build(boxes, False, centers, radius, order, pixels, reach=True), floor, pc
+    return grids.build(boxes, False, centers, radius, order, pixels, reach=True, jobs=fr.jobs), floor, pc
 
 
 #: shadow_origins' output: bounding box of the points, largest magnitude, largest chord,
@@ -372,7 +347,7 @@ class _ShadowGrid:
     radius: np.ndarray  # cull radius per shape
     along: np.ndarray  # a directional light's l in normal space and a2, per shape
     behind: np.ndarray | None = None  # a directional light's behind terms per shape
-    reach: np.ndarray | None = None  # ... and per list entry, what the rest of the list reaches
+    reach: np.ndarray | None = None  # ... and at every fourth entry, what the rest of the list reaches
 
 
 def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.ndarray, n_pix: int) -> _ShadowGrid:
@@ -400,7 +375,7 @@ def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.n
         if not boxes[:, 4].any():
             return unbounded
         bounded = fr.bounded & bool(np.isfinite(apex).all())
-        radius = bounds.cull_radii(fr.bnd, bounded, far, float(boxes[:, 5].min()), u, tiny, fr.fp16)
+        radius = bounds.cull_radii(fr.bnd, bounded, far, float(boxes[:, 5].min()), u, tiny, fr.fp16, fr.jobs)
         radius += far * (chord * (1 + bounds.SLACK) + 1e-15) + slack
         return _ShadowGrid(grids.build(boxes, False, centers - apex, radius, np.arange(n, dtype=np.int32)), radius,
                            along)
@@ -416,7 +391,7 @@ def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.n
     pad = 1e-9 * (np.abs(uv).max() + magnitude)
     boxes = grids.EMPTY_BOXES.copy()
     boxes[0, :5] = low[0] - pad, high[0] + pad, low[1] - pad, high[1] + pad, hits[native.OUT_HITS]
-    radius = bounds.cull_radii(fr.bnd, fr.bounded, far, length, u, tiny, fr.fp16) + slack
+    radius = bounds.cull_radii(fr.bnd, fr.bounded, far, length, u, tiny, fr.fp16, fr.jobs) + slack
     flat = np.zeros((n, 3))
     with np.errstate(all="ignore"):  # unbounded shapes (infinite centres) have an infinite radius
         flat[:, :2] = _project(centers, axes)
@@ -427,12 +402,15 @@ def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.n
         ahead = behind[:, 0] + np.maximum(radius, (behind[:, 2] * radius + 0.015625 / length)
                                           / (behind[:, 1] - behind[:, 2]))
     order = np.argsort(-np.nan_to_num(ahead, nan=np.inf), kind="stable").astype(np.int32)
-    grid = grids.build(boxes, True, flat, radius, order, rays_per_cell=32)
-    reach = np.empty((len(grid.entries), 3))
+    grid = grids.build(boxes, True, flat, radius, order, rays_per_cell=32, jobs=fr.jobs)
+    reach = np.empty((-(-len(grid.entries) // 4), 3))  # at every fourth entry
     su, sv = grid.faces[0, native.GF_SU], grid.faces[0, native.GF_SV]
     diag = float(np.hypot(1 / su, 1 / sv)) if su > 0 and sv > 0 else np.inf  # a cell's diagonal
-    native.library().behind_reach(grid.start.ctypes.data, grid.cells, grid.entries.ctypes.data, behind.ctypes.data,
-                                  radius.ctypes.data, diag, length, reach.ctypes.data)
+    lib, keys = native.library(), np.empty((n, 3))
+    lib.behind_keys(behind.ctypes.data, radius.ctypes.data, n, diag, length, keys.ctypes.data)
+    threads.split(fr.jobs, grid.cells, max(1, grid.cells * grids.CELL_CHUNK // max(1, len(grid.entries))),
+                  lambda a, b: lib.behind_reach(grid.start.ctypes.data, a, b, grid.entries.ctypes.data,
+                                                keys.ctypes.data, reach.ctypes.data))
     return _ShadowGrid(grid, radius, along, behind, reach)
 
 

@@ -2,9 +2,10 @@
  *
  * Built with the float semantics the emulator needs: no contraction of a*b+c into fused
  * multiply-adds, no fast-math, IEEE subnormals (setup.py passes -ffp-contract=off).
- * The datapath is written once (datapath.inc) and instantiated per working precision:
- * _f32 (fp32), _h16 (fp16, subnormals flushed), _h16i (fp16, IEEE subnormals), _f64
- * (fp64). Grid building and bounds work in double.
+ * The datapath is written once (datapath.inc) and instantiated per working precision
+ * and instruction set in instances/: _f32 (fp32), _h16 (fp16, subnormals flushed), _h16i
+ * (fp16, IEEE subnormals), _f64 (fp64), each _base and _avx2. This file holds the rest:
+ * grid building and bounds, in double.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -20,11 +21,7 @@
 #include "simd.h"
 #include "cull.h"
 
-#define ISA base
-#include "instances.inc"
-#undef ISA
-
-/* Whether this processor runs the AVX2 build of the kernels (kernels_avx2.c). */
+/* Whether this processor runs the AVX2 build of the kernels (the _avx2 files of instances/). */
 int32_t have_avx2(void)
 {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -189,52 +186,73 @@ static void cone_union(double *a1, double *t1, const double *a2_, double t2)
     *t1 = t * (1.0 + 1e-12) + 1e-12;
 }
 
-/* A perspective grid's reach (Grid.reach): for each cell, backwards over its list, the
- * union of the lines' cones of the entry's ball and every later one (centres relative to
- * the apex, cull radii), written at entries that are multiples of 4. The stored cone is
- * widened by 1e-6 rad for the float axis (its error is below 1e-7 rad) and its cosine
- * rounded down. */
-void cone_reach(const double *centers, const double *radii, const int64_t *start, int64_t cells,
-                const int32_t *entries, float *out)
+/* Per shape, what cone_reach needs of its ball seen from the apex (CONE_COLUMNS doubles):
+ * the unit axis, the half-angle t (pi/2: every line), and sin t, cos t for the
+ * containment test; centres relative to the apex, cull radii. */
+void cone_balls(const double *centers, const double *radii, int64_t n, double *out)
 {
-    for (int64_t k = 0; k < cells; k++) {
-        double axis[3] = {0, 0, 1}, angle = -1.0, cos_a = 1.0;
+    for (int64_t s = 0; s < n; s++) {
+        const double *c = centers + 3 * s;
+        double r = radii[s], dist = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), *o = out + CONE_COLUMNS * s;
+        int ball = dist > r && r < INFINITY && dist < INFINITY;
+        double sr = r / dist;
+        o[0] = c[0] / dist; o[1] = c[1] / dist; o[2] = c[2] / dist;
+        o[3] = ball ? asin(sr) * (1.0 + 1e-12) + 1e-12 : HALF_PI;
+        o[4] = sr;
+        o[5] = sqrt(fmax(0.0, 1.0 - sr * sr));
+    }
+}
+
+/* A perspective grid's reach (Grid.reach) for cells k0..k1: for each cell, backwards over
+ * its list, the union of the lines' cones of the entry's ball (cone_balls) and every
+ * later one, written at entries that are multiples of 4. The stored cone is widened by
+ * 1e-6 rad for the float axis (its error is below 1e-7 rad) and its cosine rounded down. */
+void cone_reach(const double *balls, const int64_t *start, int64_t k0, int64_t k1, const int32_t *entries,
+                float *out)
+{
+    for (int64_t k = k0; k < k1; k++) {
+        double axis[3] = {0, 0, 1}, angle = -1.0, cos_a = 1.0, written = -2.0;
+        float stored[4] = {0};
         for (int64_t i = start[k + 1] - 1; i >= start[k]; i--) {
-            const double *c = centers + 3 * (int64_t)entries[i];
-            double r = radii[entries[i]], dist = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-            double a[3] = {c[0] / dist, c[1] / dist, c[2] / dist};
+            const double *ball = balls + CONE_COLUMNS * (int64_t)entries[i], *a = ball, t = ball[3];
             int inside = 0;
-            if (angle >= 0 && angle < HALF_PI && dist > r && r < INFINITY && dist < INFINITY) {
+            if (angle >= 0 && angle < HALF_PI && t < HALF_PI) {
                 /* the ball inside the cone without trigonometry: the angle between the axis and
-                 * the centre plus asin(r / dist) at most the cone's, with room for rounding */
-                double dot = fabs(axis[0] * a[0] + axis[1] * a[1] + axis[2] * a[2]), sr = r / dist;
-                double cr = sqrt(fmax(0.0, 1.0 - sr * sr)), sine = sqrt(fmax(0.0, 1.0 - dot * dot));
-                inside = dot * cr - sine * sr >= cos_a + 1e-9;  /* cos(angle to axis + ball's half-angle) */
+                 * the centre plus the ball's half-angle at most the cone's, with room for rounding */
+                double dot = fabs(axis[0] * a[0] + axis[1] * a[1] + axis[2] * a[2]);
+                double sine = sqrt(fmax(0.0, 1.0 - dot * dot));
+                inside = dot * ball[5] - sine * ball[4] >= cos_a + 1e-9;  /* cos(angle to axis + half-angle) */
             }
             if (!inside) {
-                double t = dist > r && r < INFINITY && dist < INFINITY ? asin(r / dist) * (1.0 + 1e-12) + 1e-12 : HALF_PI;
+                double before = angle, was[3] = {axis[0], axis[1], axis[2]};
                 if (angle < 0) {
-                    memcpy(axis, a, sizeof a);
+                    memcpy(axis, a, sizeof axis);
                     angle = t;
                 } else {
                     cone_union(axis, &angle, a, t);
                 }
-                cos_a = cos(angle);
+                if (angle != before)
+                    cos_a = cos(angle);
+                if (memcmp(was, axis, sizeof was) != 0)
+                    written = -2.0;  /* the axis turned */
             }
             if (i % 4 == 0) {
-                float *o = out + i;
-                int every = !(angle + 1e-6 < HALF_PI) || !(axis[0] == axis[0]);
-                for (int q = 0; q < 3; q++)
-                    o[q] = every ? 0.0f : (float)axis[q];
-                float cs = (float)cos(angle + 1e-6);
-                o[3] = every ? -2.0f : ((double)cs > cos(angle + 1e-6) ? nextafterf(cs, -INFINITY) : cs);
+                if (written != angle) {  /* else the same cone as the last one written */
+                    int every = !(angle + 1e-6 < HALF_PI) || !(axis[0] == axis[0]);
+                    for (int q = 0; q < 3; q++)
+                        stored[q] = every ? 0.0f : (float)axis[q];
+                    float cs = (float)cos(angle + 1e-6);
+                    stored[3] = every ? -2.0f : ((double)cs > cos(angle + 1e-6) ? nextafterf(cs, -INFINITY) : cs);
+                    written = angle;
+                }
+                memcpy(out + i, stored, sizeof stored);
             }
         }
     }
 }
 
-/* A directional light's reach per entry of its shadow grid (LightPass.reach), from the
- * behind terms and cull radii per shape; diag: a cell's diagonal, l_len: |l|.
+/* A directional light's stop keys per shape (BEHIND_COLUMNS; LightPass.reach), from the
+ * behind terms and cull radii; diag: a cell's diagonal, l_len: |l|.
  *
  * blocked() skips shape c for a packet when ahead = least - bh0 > 0, mid - spread > r and
  * l_len (bh1 ahead - bh2 (mid + spread)) > 1/64, mid being the distance from the packet's
@@ -245,23 +263,35 @@ void cone_reach(const double *centers, const double *radii, const int64_t *start
  * the first two conditions, and least >= K0 + K1 spread, K0 = bh0 + (b2 (r + diag) +
  * 1/(64 l_len)) / (bh1 - b2), K1 = 3 b2 / (bh1 - b2), the third (b2: bh2 widened by 1e-8
  * for the rounding of mid; r likewise). A shape without a test gets infinities. */
-void behind_reach(const int64_t *start, int64_t cells, const int32_t *entries, const double *behind,
-                  const double *radius, double diag, double l_len, double *out)
+void behind_keys(const double *behind, const double *radius, int64_t n, double diag, double l_len, double *out)
 {
-    for (int64_t k = 0; k < cells; k++) {
+    for (int64_t s = 0; s < n; s++) {
+        const double *bh = behind + 3 * s;
+        double r = radius[s] * (1.0 + 1e-8), b2 = bh[2] * (1.0 + 1e-8), a = bh[1] - b2;
+        double pad = 1e-12 * (fabs(bh[0]) + r + diag);
+        double key[3] = {bh[0] + (b2 * (r + diag) + 0.015625 / l_len) / a + pad, 3.0 * b2 / a, bh[0] + r + pad};
+        int ok = bh[0] == bh[0] && a > 0 && r < INFINITY;
+        for (int c = 0; c < 3; c++)
+            ok &= key[c] == key[c] && key[c] < INFINITY;
+        for (int c = 0; c < 3; c++)
+            out[3 * s + c] = ok ? key[c] : INFINITY;
+    }
+}
+
+/* The reach of cells k0..k1 of a directional light's shadow grid at entries i that are
+ * multiples of 4 (out + 3 (i / 4)): per key, the largest over the entry and every later
+ * one of its list (behind_keys). */
+void behind_reach(const int64_t *start, int64_t k0, int64_t k1, const int32_t *entries, const double *keys,
+                  double *out)
+{
+    for (int64_t k = k0; k < k1; k++) {
         double m[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int64_t i = start[k + 1] - 1; i >= start[k]; i--) {
-            const double *bh = behind + 3 * (int64_t)entries[i];
-            double r = radius[entries[i]] * (1.0 + 1e-8), b2 = bh[2] * (1.0 + 1e-8), a = bh[1] - b2;
-            double pad = 1e-12 * (fabs(bh[0]) + r + diag);
-            double key[3] = {bh[0] + (b2 * (r + diag) + 0.015625 / l_len) / a + pad, 3.0 * b2 / a, bh[0] + r + pad};
-            int ok = bh[0] == bh[0] && a > 0 && r < INFINITY;
+            const double *key = keys + 3 * (int64_t)entries[i];
             for (int c = 0; c < 3; c++)
-                ok &= key[c] == key[c] && key[c] < INFINITY;
-            for (int c = 0; c < 3; c++) {
-                m[c] = MAX(m[c], ok ? key[c] : INFINITY);
-                out[3 * i + c] = m[c];
-            }
+                m[c] = MAX(m[c], key[c]);
+            if (i % 4 == 0)
+                memcpy(out + 3 * (i / 4), m, sizeof m);
         }
     }
 }

@@ -27,6 +27,8 @@ enum { LT_KIND = 0, LT_LOC = 1, LT_DIR = 4, LT_INTENSITY = 7, LT_COLUMNS = 8 };
 enum { LIGHT_DIRECTIONAL = 1, LIGHT_POINT = 2 };
 /* Grid face columns (double): the rays' u0, u1, v0, v1, then cells per unit of u, v;
  * face ints: cells along u, along v, first cell. */
+/* cone_balls: unit axis, half-angle, its sine and cosine per shape. */
+enum { CONE_COLUMNS = 6 };
 enum { GF_U0 = 0, GF_U1 = 1, GF_V0 = 2, GF_V1 = 3, GF_SU = 4, GF_SV = 5, GF_COLUMNS = 6 };
 enum { GS_NU = 0, GS_NV = 1, GS_FIRST = 2, GS_COLUMNS = 3 };
 /* Per-face ray statistics: u0, u1, v0, v1, rays, shortest and longest direction. */
@@ -106,11 +108,12 @@ typedef struct {            /* one light over one band */
                                and (spread2 + 64 uu smax^2), NaN where no test applies */
     double l_hat[3], l_len; /* a directional light's l/|l| and |l| */
     const double *radius;   /* cull radius per shape, for these shadow rays */
-    /* Per entry of the grid's lists (directional light; else NULL): K0, K1, K2, the
-     * largest over the entry's shape and every later one of its cell (kernels.c
-     * behind_reach); a packet whose origins lie at depth >= least along l within spread
-     * of their centre skips the rest of the list once least >= max(K0 + K1 spread,
-     * K2 + 2 spread), as every shape left lies behind every origin. */
+    /* At every fourth entry of the grid's lists (directional light; else NULL): K0, K1,
+     * K2, the largest over the entry's shape and every later one of its cell (kernels.c
+     * behind_reach; entry i's at reach + 3 (i / 4)); a packet whose origins lie at depth
+     * >= least along l within spread of their centre skips the rest of the list once
+     * least >= max(K0 + K1 spread, K2 + 2 spread), as every shape left lies behind every
+     * origin. */
     const double *reach;
     Grid grid;
     double *acc;            /* pixels x 3 colour sums */

@@ -16,7 +16,7 @@ from . import native, threads
 
 SLACK = 1e-9
 #: Shapes a thread takes at least.
-SHAPE_CHUNK = 1 << 12
+SHAPE_CHUNK = 1 << 10
 
 
 def cull_radii(table: np.ndarray, ok: np.ndarray, dist: np.ndarray, dmin: float, u: float, tiny: float,
@@ -27,7 +27,7 @@ def cull_radii(table: np.ndarray, ok: np.ndarray, dist: np.ndarray, dmin: float,
     out = np.empty(len(table))
     table, flags, dist = _inputs(table, ok, dist)
     lib = native.library()
-    threads.split(jobs, len(out), SHAPE_CHUNK, lambda a, b: lib.bound_radii(
+    threads.split(jobs, threads.ranges(len(out), jobs, SHAPE_CHUNK), lambda a, b: lib.bound_radii(
         table[a:].ctypes.data, flags[a:].ctypes.data, dist[a:].ctypes.data, b - a, dmin, u, tiny, int(fp16),
         out[a:].ctypes.data))
     return out
@@ -41,7 +41,7 @@ def depth_floors(table: np.ndarray, ok: np.ndarray, dist: np.ndarray, dmin: floa
     out = np.empty(len(table))
     table, flags, dist = _inputs(table, ok, dist)
     lib = native.library()
-    threads.split(jobs, len(out), SHAPE_CHUNK, lambda a, b: lib.bound_floors(
+    threads.split(jobs, threads.ranges(len(out), jobs, SHAPE_CHUNK), lambda a, b: lib.bound_floors(
         table[a:].ctypes.data, flags[a:].ctypes.data, dist[a:].ctypes.data, b - a, dmin, dmax, u, tiny,
         out[a:].ctypes.data))
     return out

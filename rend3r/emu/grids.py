@@ -42,8 +42,9 @@ MAX_CELLS_PER_AXIS = 4096
 #: to MAX_BLOCK columns x rows): deep scenes list every shape behind a pixel.
 PIXEL_ENTRIES, MAX_BLOCK = 2, (64, 16)
 #: Per face: u0, u1, v0, v1, rays, shortest and longest direction (as the kernels fill it).
-#: Entries of the cell lists, and shapes, a thread takes at least.
-CELL_CHUNK, SHAPE_CHUNK = 1 << 14, 1 << 12
+#: Entries of the cell lists (work of filling or reaching them), and shapes, a thread
+#: takes at least.
+CELL_CHUNK, SHAPE_CHUNK = 1 << 14, 1 << 9
 EMPTY_BOXES = np.tile(np.array([np.inf, -np.inf, np.inf, -np.inf, 0.0, np.inf, -np.inf]), (3, 1))
 
 
@@ -177,17 +178,42 @@ def _footprints(faces: np.ndarray, shape: np.ndarray, layout: tuple | None, para
     these face tables (csrc/kernels.c grid_footprints), shapes split over ``jobs`` threads."""
     empty = Grid(faces, shape, np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0, np.int32), layout)
     view, lib = empty.struct(), native.library()
-    threads.split(jobs, len(radii), SHAPE_CHUNK, lambda a, b: lib.grid_footprints(
+    threads.split(jobs, threads.ranges(len(radii), jobs, SHAPE_CHUNK), lambda a, b: lib.grid_footprints(
         byref(view), int(parallel), centers[a:].ctypes.data, radii[a:].ctypes.data, b - a, rects[a:].ctypes.data))
 
 
-def _fill(rects: np.ndarray, shape: np.ndarray, order: np.ndarray, listed: np.ndarray, cells: int,
-          jobs: int) -> tuple[np.ndarray, np.ndarray]:
-    """The cell lists (start, entries) of the ``listed`` shapes in ``order``: each thread
-    counts, then writes, a range of ``order`` at the places the earlier ranges leave it, so
-    the lists are the same for any split (csrc/kernels.c grid_fill)."""
+def _blocks(pixels: PixelLayout, px: np.ndarray) -> PixelLayout:
+    """The finest blocks, from ``pixels``' own through PixelLayout.coarser's to MAX_BLOCK,
+    whose lists hold the shapes' pixel rectangles ``px`` (n, 4: c0, c1, r0, r1) in at most
+    PIXEL_ENTRIES entries per pixel; else the coarsest. Blocks double, so a rectangle's
+    block count never grows as they coarsen, and a binary search finds them."""
+    layouts = [pixels]
+    while (layouts[-1].block, layouts[-1].block_rows) != MAX_BLOCK:
+        layouts.append(layouts[-1].coarser())
+    c0, c1, r0, r1 = px.T.astype(np.int32)  # pixel indices: at most 8192
+
+    def fits(p: PixelLayout) -> bool:
+        u, v = p.block.bit_length() - 1, p.block_rows.bit_length() - 1  # powers of two
+        counts = ((c1 >> u) - (c0 >> u) + 1) * ((r1 >> v) - (r0 >> v) + 1)
+        return int(counts.sum(dtype=np.int64)) <= PIXEL_ENTRIES * p.pixels
+
+    lo, hi = 0, len(layouts) - 1
+    while lo < hi:
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if fits(layouts[mid]) else (mid + 1, hi)
+    return layouts[lo]
+
+
+def _fill(rects: np.ndarray, shape: np.ndarray, order: np.ndarray, listed: np.ndarray, sizes: np.ndarray,
+          cells: int, jobs: int) -> tuple[np.ndarray, np.ndarray]:
+    """The cell lists (start, entries) of the ``listed`` shapes in ``order`` (``sizes``:
+    each shape's cells): each thread counts, then writes, a range of ``order`` at the
+    places the earlier ranges leave it, so the lists are the same for any split
+    (csrc/kernels.c grid_fill)."""
     lib, flags = native.library(), listed.astype(np.uint8)
-    parts = threads.ranges(len(order), jobs, SHAPE_CHUNK)
+    work = np.zeros(len(order) + 1, np.int64)
+    np.cumsum(np.where(listed, sizes, 0)[order] + 1, out=work[1:])
+    parts = threads.balanced(work, jobs, CELL_CHUNK)
     counts = np.zeros((len(parts), cells), np.int64)
 
     def run(pos: np.ndarray, entries: np.ndarray | None) -> None:
@@ -229,13 +255,7 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
         faces, shape, layout = _pixel_faces(one)
         _footprints(faces, shape, layout, False, centers, radii, rects, jobs)
         px, none = rects[:, 2].copy(), rects[:, 2, 0] > rects[:, 2, 1]
-        c0, c1, r0, r1 = px[(rects[:, 0, 0] >= 0) & ~none].T  # the listed shapes' pixel rectangles
-        while True:  # the finest blocks whose lists stay within budget
-            total = int((((c1 // pixels.block) - (c0 // pixels.block) + 1)
-                         * ((r1 // pixels.block_rows) - (r0 // pixels.block_rows) + 1)).sum())
-            if total <= PIXEL_ENTRIES * pixels.pixels or (pixels.block, pixels.block_rows) == MAX_BLOCK:
-                break
-            pixels = pixels.coarser()
+        pixels = _blocks(pixels, px[(rects[:, 0, 0] >= 0) & ~none])
         rects[:, 2] = px // [pixels.block, pixels.block, pixels.block_rows, pixels.block_rows]
         rects[none, 2] = (1, 0, 0, 0)
         sizes = _sizes(rects)
@@ -260,13 +280,13 @@ def build(boxes: np.ndarray, parallel: bool, centers: np.ndarray, radii: np.ndar
         left = total - np.cumsum(sizes[big])
         listed[big[: int(np.searchsorted(-left, -budget)) + 1]] = False
     n_cells = int((shape[:, 0] * shape[:, 1]).sum())
-    start, entries = _fill(rects, shape, order, listed, n_cells, jobs)
+    start, entries = _fill(rects, shape, order, listed, sizes, n_cells, jobs)
     cones = None
     if reach and not parallel:  # the lines the rest of each list may hit, for packets to stop early
         cones = np.empty(-(-len(entries) // 4) * 4, np.float32)
         balls = np.empty((n, native.CONE_COLUMNS))
         lib.cone_balls(centers.ctypes.data, radii.ctypes.data, n, balls.ctypes.data)
-        threads.split(jobs, n_cells, max(1, n_cells * CELL_CHUNK // max(1, len(entries))),
+        threads.split(jobs, threads.balanced(start + np.arange(n_cells + 1), jobs, CELL_CHUNK),
                       lambda a, b: lib.cone_reach(balls.ctypes.data, start.ctypes.data, a, b, entries.ctypes.data,
                                                   cones.ctypes.data))
     return Grid(faces, shape, start, entries, order[~listed[order]], layout, cones)

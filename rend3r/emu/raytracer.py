@@ -408,7 +408,7 @@ def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.n
     diag = float(np.hypot(1 / su, 1 / sv)) if su > 0 and sv > 0 else np.inf  # a cell's diagonal
     lib, keys = native.library(), np.empty((n, 3))
     lib.behind_keys(behind.ctypes.data, radius.ctypes.data, n, diag, length, keys.ctypes.data)
-    threads.split(fr.jobs, grid.cells, max(1, grid.cells * grids.CELL_CHUNK // max(1, len(grid.entries))),
+    threads.split(fr.jobs, threads.balanced(grid.start + np.arange(grid.cells + 1), fr.jobs, grids.CELL_CHUNK),
                   lambda a, b: lib.behind_reach(grid.start.ctypes.data, a, b, grid.entries.ctypes.data,
                                                 keys.ctypes.data, reach.ctypes.data))
     return _ShadowGrid(grid, radius, along, behind, reach)

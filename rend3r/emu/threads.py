@@ -12,6 +12,8 @@ from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 from typing import Callable
 
+import numpy as np
+
 
 def available_cores() -> int:
     """Cores this process may run on."""
@@ -34,6 +36,16 @@ def ranges(n: int, jobs: int, smallest: int) -> list[tuple[int, int]]:
     return [(a, b) for a, b in zip(edges, edges[1:]) if b > a]
 
 
+def balanced(cum: np.ndarray, jobs: int, smallest: int) -> list[tuple[int, int]]:
+    """Ranges of items 0..m whose work ``cum`` (m + 1 running totals from 0) is about
+    even: a few per thread, none under ``smallest`` work unless there is only one."""
+    m, total = len(cum) - 1, int(cum[-1])
+    parts = 1 if jobs <= 1 else max(1, min(4 * jobs, total // max(1, smallest)))
+    cuts = np.searchsorted(cum, [total * k // parts for k in range(1, parts)]).tolist()
+    edges = sorted({0, m, *(min(max(c, 0), m) for c in cuts)})
+    return [(a, b) for a, b in zip(edges, edges[1:])]
+
+
 def each(jobs: int, calls: list[Callable[[], object]]) -> None:
     """Run ``calls`` on ``jobs`` threads (in this thread with one job or one call)."""
     if jobs <= 1 or len(calls) <= 1:
@@ -44,6 +56,6 @@ def each(jobs: int, calls: list[Callable[[], object]]) -> None:
             future.result()
 
 
-def split(jobs: int, n: int, smallest: int, fn: Callable[[int, int], object]) -> None:
-    """``fn(a, b)`` over ranges of 0..n on ``jobs`` threads."""
-    each(jobs, [lambda a=a, b=b: fn(a, b) for a, b in ranges(n, jobs, smallest)])
+def split(jobs: int, parts: list[tuple[int, int]], fn: Callable[[int, int], object]) -> None:
+    """``fn(a, b)`` over the ranges ``parts`` on ``jobs`` threads."""
+    each(jobs, [lambda a=a, b=b: fn(a, b) for a, b in parts])

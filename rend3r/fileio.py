@@ -1,6 +1,10 @@
 """File input and output with limits: reads stop at a size cap (so ``/dev/zero``, a FIFO
-or a huge sparse file ends with an error naming the limit), and writes are atomic (a
-reader never sees a half-written file, and a failed write leaves nothing behind)."""
+or a huge sparse file ends with an error naming the limit), writes are atomic (a reader
+never sees a half-written file, and a failed write leaves nothing behind), and a
+command's outputs are all or nothing (:class:`Outputs`): every output is checked before
+any work, staged under a hidden name beside its target, and renamed into place only when
+the whole run has succeeded; when anything fails first, the staged files and the folders
+the run created are removed and every file it would have replaced is left as it was."""
 
 from __future__ import annotations
 
@@ -52,7 +56,7 @@ def write_atomic(path: str | os.PathLike[str], data: bytes) -> None:
     """
     target = Path(path)
     directory = target.parent
-    tmp = directory / f".{target.name}.{secrets.token_hex(6)}.tmp"
+    tmp = directory / f".rend3r-{secrets.token_hex(6)}.tmp"  # short: any target name fits
     try:
         # 0o666 filtered by the umask, as for an ordinary new file.
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
@@ -94,3 +98,161 @@ def _fsync_directory(directory: Path) -> None:
         pass
     finally:
         os.close(fd)
+
+
+class Outputs:
+    """The files of one run; use as a context manager (an exception aborts the run)."""
+
+    def __init__(self) -> None:
+        self._reserved: dict[str, Path] = {}
+        self._staged: dict[Path, Path] = {}  # target -> staged file
+        self._made: list[Path] = []  # folders this run created, parents first
+
+    def reserve(self, path: str | os.PathLike[str], *, make_parents: bool = False) -> Path:
+        """Check now that ``path`` can be written: named once, not a folder, its folder
+        existing (or creatable when ``make_parents``) and writable. Rend3rError otherwise."""
+        p = Path(path)
+        key = os.path.abspath(p)  # no file system access: safe before the checks
+        if key in self._reserved:
+            raise Rend3rError(f"{p}: named by two outputs of this run")
+        try:
+            self._check(p, make_parents)
+        except OSError as exc:
+            raise Rend3rError(f"{p}: cannot write: {exc.strerror or exc}") from None
+        self._reserved[key] = p
+        return p
+
+    @staticmethod
+    def _check(p: Path, make_parents: bool) -> None:
+        if "\0" in str(p):
+            raise Rend3rError(f"{str(p)!r}: cannot write: a file name cannot hold a NUL byte")
+        folder = p.parent
+        while make_parents and folder != folder.parent and not folder.exists():
+            folder = folder.parent
+        longest = _name_max(folder)
+        for part in p.parts:
+            if len(os.fsencode(part)) > longest:
+                raise Rend3rError(f"{p}: cannot write: a name in it is longer than {longest} bytes")
+        if p.is_dir():
+            raise Rend3rError(f"{p}: cannot write: it is a folder")
+        if not folder.exists():
+            raise Rend3rError(f"{p}: folder {p.parent} does not exist")
+        if not folder.is_dir():
+            raise Rend3rError(f"{p}: cannot write: {folder} is not a folder")
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise Rend3rError(f"{p}: cannot write: folder {folder} is not writable")
+
+    def write(self, path: str | os.PathLike[str], data: bytes) -> None:
+        """Stage ``data`` for ``path`` (reserved or not); it appears there at :meth:`commit`."""
+        p = Path(path)
+        if os.path.abspath(p) not in self._reserved:
+            self.reserve(p, make_parents=True)
+        self._make_folders(p.parent)
+        old = self._staged.pop(p, None)
+        if old is not None:
+            old.unlink(missing_ok=True)
+        stage = p.with_name(f".rend3r-{secrets.token_hex(6)}.part")  # short: any target name fits
+        try:
+            write_atomic(stage, data)
+        except Rend3rError as exc:
+            raise Rend3rError(str(exc).replace(str(stage), str(p))) from None
+        self._staged[p] = stage
+
+    def commit(self) -> None:
+        """Move every staged file into place; if one cannot be, put back the ones already
+        moved (the files they replaced come back from hard-link backups) and raise."""
+        done: list[tuple[Path, Path | bool]] = []
+        try:
+            for target, stage in self._staged.items():
+                backup = _backup(target)
+                try:
+                    os.replace(stage, target)
+                except OSError as exc:
+                    if isinstance(backup, Path):
+                        backup.unlink(missing_ok=True)
+                    raise Rend3rError(f"{target}: cannot write: {exc.strerror or exc}") from None
+                done.append((target, backup))
+        except BaseException:
+            for target, backup in reversed(done):
+                _restore(target, backup)
+            self.abort()
+            raise
+        for _, backup in done:
+            if isinstance(backup, Path):
+                backup.unlink(missing_ok=True)
+        self._staged.clear()
+        self._made.clear()
+
+    def abort(self) -> None:
+        """Remove the staged files and the folders this run created (if still empty)."""
+        for stage in self._staged.values():
+            stage.unlink(missing_ok=True)
+        self._staged.clear()
+        for folder in reversed(self._made):
+            try:
+                folder.rmdir()
+            except OSError:
+                pass
+        self._made.clear()
+
+    def __enter__(self) -> Outputs:
+        return self
+
+    def __exit__(self, kind, value, tb) -> None:
+        if kind is not None:
+            self.abort()
+
+    def _make_folders(self, folder: Path) -> None:
+        missing = []
+        while not folder.exists() and folder != folder.parent:
+            missing.append(folder)
+            folder = folder.parent
+        for f in reversed(missing):
+            try:
+                f.mkdir()
+            except OSError as exc:
+                raise Rend3rError(f"cannot create folder {f}: {exc.strerror or exc}") from None
+            self._made.append(f)
+
+
+def _name_max(folder: Path) -> int:
+    """The longest file name ``folder``'s filesystem takes (255 where it does not say)."""
+    try:
+        return os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        return 255
+
+
+def _backup(target: Path) -> Path | bool:
+    """A hard link to the file ``target`` is about to replace; False when there is none
+    (a new file); True when it exists but this filesystem has no hard links (the file is
+    then not restored: the up-front checks leave the rename itself as the only risk)."""
+    if not os.path.lexists(target):
+        return False
+    link = target.with_name(f".rend3r-{secrets.token_hex(6)}.old")
+    try:
+        os.link(target, link, follow_symlinks=False)
+    except OSError:
+        return True
+    return link
+
+
+def _restore(target: Path, backup: Path | bool) -> None:
+    """Undo one committed rename (best effort: the error is already being raised)."""
+    try:
+        if backup is False:
+            target.unlink(missing_ok=True)
+        elif isinstance(backup, Path):
+            os.replace(backup, target)
+    except OSError:
+        pass
+
+
+def write_all(outputs: list[tuple[str | os.PathLike[str], bytes]]) -> None:
+    """Write every ``(path, data)``, all or nothing (:class:`Outputs`)."""
+    with Outputs() as out:
+        for path, _ in outputs:
+            out.reserve(path)
+        for path, data in outputs:
+            out.write(path, data)
+        out.commit()

@@ -83,7 +83,7 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
                         save_animation, save_depth, save_png, save_provenance)
     from .loader import load_program
     from .options import EmuOptions
-    from .outputs import Outputs
+    from ..fileio import Outputs
     from .processor import execute
     from .quirks import apply_quirks, quirk_names
     from .run import run_program

@@ -93,7 +93,7 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
     from .fileformat import SvoModel, encode_svo
     from .mesh_io import encode_binvox, read_binvox, read_mesh
     from .octree import build_octree_codes, morton_decode, morton_encode
-    from .outputs import write_all
+    from ..fileio import write_all
     from .voxelize import voxelize_codes
 
     budget = max_memory or default_budget()
@@ -207,7 +207,7 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
     from ..emu.image import check_output
     from .camera import model_matrix, orbit_camera
     from .fileformat import read_svo
-    from .outputs import write_all
+    from ..fileio import write_all
     from .render import cost_image, render
 
     for path in (output, cost_path):
@@ -266,7 +266,7 @@ def _png(image) -> bytes:
 def sweep_cmd(model: str, output: str, size, views: int, jobs: int) -> None:
     """Simulate the design points of the thesis's Tables 7.1 and 8.2 on MODEL.svo."""
     from .fileformat import read_svo
-    from .outputs import write_all
+    from ..fileio import write_all
     from .sweep import run_sweep, thesis_points, to_csv, to_markdown
 
     _kernel("auto", True)

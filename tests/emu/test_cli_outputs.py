@@ -208,7 +208,7 @@ def test_no_numpy_warning_reaches_the_terminal_with_extreme_values(tmp_path, spe
 
 
 def test_outputs_commit_all_or_roll_back_every_one(tmp_path):
-    from rend3r.emu.outputs import Outputs
+    from rend3r.fileio import Outputs
 
     (tmp_path / "old.png").write_bytes(b"old")
     out = Outputs()
@@ -234,7 +234,7 @@ def test_outputs_commit_all_or_roll_back_every_one(tmp_path):
 
 
 def test_outputs_abort_on_an_exception_inside_the_run(tmp_path):
-    from rend3r.emu.outputs import Outputs
+    from rend3r.fileio import Outputs
 
     with pytest.raises(KeyboardInterrupt):
         with Outputs() as out:

@@ -4,7 +4,8 @@ Each case is one ``python -m rend3r ...`` child, so a crash (a signal) is seen a
 and not as the end of the fuzzer, and each child's own time and peak RSS are measured
 (``os.wait4`` gives the child's resource usage). A case *passes* when the command exits
 0, 1 or 2 and its stderr holds no Python traceback; exit 1 and 2 must come with an
-``error:`` line. Limits: ``timeout`` seconds (a hang is reported, not waited on) and
+``error:`` line, except the exits a command documents as verdicts (``verdicts``: e.g.
+``trace-diff``'s 1, "traces differ", printed on standard output). Limits: ``timeout`` seconds (a hang is reported, not waited on) and
 ``max_rss`` bytes of address space (``RLIMIT_AS``), so a memory blow-up ends as a
 failed case instead of taking the machine.
 
@@ -38,6 +39,7 @@ class CaseResult:
     rss_bytes: int
     stderr: str
     timed_out: bool
+    verdicts: tuple[int, ...] = ()
 
     @property
     def crashed(self) -> bool:
@@ -51,7 +53,8 @@ class CaseResult:
     @property
     def unclear(self) -> bool:
         """Failed without saying why: exit 1 or 2 with no ``error:`` line."""
-        return self.returncode in (1, 2) and "error:" not in self.stderr.lower()
+        return (self.returncode in (1, 2) and self.returncode not in self.verdicts
+                and "error:" not in self.stderr.lower())
 
     @property
     def ok(self) -> bool:
@@ -60,8 +63,9 @@ class CaseResult:
 
 
 def run_case(args: list[str], *, stdin: bytes | None = None, cwd: str | Path | None = None,
-             timeout: float = 60.0, max_rss: int = CHILD_MEMORY) -> CaseResult:
-    """Run ``python -m rend3r *args`` in a child and measure its time and its own peak RSS."""
+             timeout: float = 60.0, max_rss: int = CHILD_MEMORY, verdicts: tuple[int, ...] = ()) -> CaseResult:
+    """Run ``python -m rend3r *args`` in a child and measure its time and its own peak RSS
+    (``verdicts``: exit statuses that are documented answers, not errors)."""
 
     def limit() -> None:
         resource.setrlimit(resource.RLIMIT_AS, (max_rss, max_rss))
@@ -91,7 +95,7 @@ def run_case(args: list[str], *, stdin: bytes | None = None, cwd: str | Path | N
         err.seek(0)
         text = err.read().decode("utf-8", "replace")
     return CaseResult(tuple(args), child.returncode, seconds, usage.ru_maxrss * 1024, text,
-                      timed_out)
+                      timed_out, verdicts)
 
 
 @dataclass
@@ -127,6 +131,9 @@ class Tally:
                 f"| {self.unclear} | {self.worst_seconds:.2f} s | {self.worst_rss / 2**20:.0f} MiB |")
 
     def print_failures(self, limit: int = 5) -> None:
+        """The first failures, and the slowest case, on standard error."""
+        print(f"{self.name}: slowest case {self.worst_seconds:.2f} s: {' '.join(self.worst_args)[:200]}",
+              file=sys.stderr)
         for result in self.failures[:limit]:
             print(f"FAILED ({result.returncode}, {result.seconds:.1f} s): {' '.join(result.args)[:200]}",
                   file=sys.stderr)

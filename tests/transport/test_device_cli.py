@@ -46,13 +46,14 @@ def test_source_to_png_over_a_pty(pty_bridge, tmp_path):
     device = start_device(["--serial", pty_bridge.paths[1], "-o", str(out), "--size", "32x24",
                            "--frames", "2"])
     try:
+        # a corrupted-in-flight frame never reaches the emulator: garbage is counted (sent
+        # first, so the device has read it once the good load's frame is out)
+        with open(pty_bridge.paths[0], "wb", buffering=0) as raw:
+            raw.write(b"\x00\x05garbage\x00")
         r = subprocess.run(RENDER + ["send", str(PROGRAMS / "sphere.asm"), "--serial",
                                      pty_bridge.paths[0]], capture_output=True, text=True, timeout=60)
         assert r.returncode == 0, r.stderr
         assert wait_for(lambda: any(out.glob("*.png")))
-        # a second, corrupted-in-flight load never reaches the emulator: garbage is counted
-        with open(pty_bridge.paths[0], "wb", buffering=0) as raw:
-            raw.write(b"\x00\x05garbage\x00")
     finally:
         err = stop_device(device)
     png = sorted(out.glob("*.png"))[0]

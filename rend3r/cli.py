@@ -15,6 +15,9 @@ from . import __version__
 from .errors import Rend3rError
 from .memory import reuse_freed_memory
 
+#: Exit status of a run stopped by Ctrl-C (128 + SIGINT, as shells report it).
+INTERRUPTED = 130
+
 #: command name -> ("module:attribute", one-line help shown by ``rend3r --help``)
 COMMANDS: dict[str, tuple[str, str]] = {
     "emulate": ("rend3r.emu.cli:emulate_command", "Run a program and render its frames to PNG, GIF or APNG (float16 golden model)."),
@@ -49,6 +52,9 @@ class LazyGroup(click.Group):
         except Rend3rError as exc:
             click.echo(str(exc) if exc.preformatted else f"rend3r: error: {exc}", err=True)
             ctx.exit(exc.exit_code)
+        except KeyboardInterrupt:  # Ctrl-C: the run's outputs were never committed
+            click.echo("\nrend3r: interrupted", err=True)
+            ctx.exit(INTERRUPTED)
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         rows = [(name, COMMANDS[name][1]) for name in self.list_commands(ctx)]

@@ -31,3 +31,22 @@ def test_source_diagnostics_are_printed_once_without_a_second_prefix(tmp_path):
         assert f"{src}:2:5: error: unknown camera property 'bogus'" in result.output
         assert result.output.count("unknown camera property") == 1
     assert not (tmp_path / "x.png").exists() and not (tmp_path / "x.mem").exists()
+
+
+def test_ctrl_c_exits_130_without_a_traceback_or_output(tmp_path):
+    """SIGINT mid-run (disasm waiting on a pipe that stays open): exit 130 as shells report
+    it, one line, and no output file."""
+    import signal
+    import time
+
+    out = tmp_path / "out.asm"
+    proc = subprocess.Popen([sys.executable, "-m", "rend3r", "disasm", "-", "-o", str(out)],
+                            stdin=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc.stdin.write("3c000000\n")
+    proc.stdin.flush()
+    time.sleep(1.5)  # past start-up: reading standard input, which never ends
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and "interrupted" in err
+    assert not out.exists()

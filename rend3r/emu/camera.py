@@ -7,6 +7,7 @@ Both return :class:`Rays` in working precision, one ray per pixel in row-major o
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 from functools import cached_property, lru_cache
 
 import numpy as np
@@ -100,12 +101,27 @@ def camera_quaternion(scene: Scene, arith: Arith) -> Quat | None:
     return tuple(arith.div(c, norm) for c in q)
 
 
+def exact_viewport_axes(width: int, height: int) -> tuple[list[Fraction], list[Fraction]]:
+    """The viewport coordinates of pixel centres as exact rationals: x right, y up."""
+    half = Fraction(1, 2)
+    ux = [Fraction(VIEW_WIDTH) * (Fraction(2 * x + 1, 2 * width) - half) for x in range(width)]
+    uy = [Fraction(VIEW_HEIGHT) * (half - Fraction(2 * y + 1, 2 * height)) for y in range(height)]
+    return ux, uy
+
+
 @lru_cache(maxsize=16)
 def _viewport_axes(arith: Arith, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
-    """Default viewport coordinates of pixel centres, each rounded once: x right, y up."""
-    x = (np.arange(width) + 0.5) / width - 0.5
-    y = 0.5 - (np.arange(height) + 0.5) / height
-    ux, uy = arith.round(VIEW_WIDTH * x), arith.round(VIEW_HEIGHT * y)
+    """Default viewport coordinates of pixel centres: x right, y up.
+
+    fp64 entries are the exact values rounded once; fp16 and fp32 entries are computed in
+    float64 and rounded to the working format (their goldens depend on these bits).
+    """
+    if arith.precision == "fp64":
+        ux, uy = (np.array([float(v) for v in axis], dtype=np.float64) for axis in exact_viewport_axes(width, height))
+    else:
+        x = (np.arange(width) + 0.5) / width - 0.5
+        y = 0.5 - (np.arange(height) + 0.5) / height
+        ux, uy = arith.round(VIEW_WIDTH * x), arith.round(VIEW_HEIGHT * y)
     ux.flags.writeable = uy.flags.writeable = False
     return ux, uy
 

@@ -108,7 +108,9 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
     loaded = load_program(program)
     options = EmuOptions(precision=precision, subnormals=subnormals, mode=mode or loaded.mode_hint or "raytrace",
                          width=size[0], height=size[1], background=background, depth=visibility, jobs=jobs)
-    options = apply_quirks(options, quirk_names(profile, quirks))
+    selected = quirk_names(profile, quirks)
+    _refuse_contradictions(selected, profile, quirks, subnormals=subnormals, visibility=visibility)
+    options = apply_quirks(options, selected)
     for x, y in pixels:
         if not (0 <= x < options.width and 0 <= y < options.height):
             raise Rend3rError(f"--trace-pixel {x},{y} is outside the {options.width}x{options.height} frame")
@@ -187,6 +189,26 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
                    f"that cannot change a pixel, overflowing ones included); see --stats", err=True)
     if show_stats:
         click.echo(result.stats.report())
+
+
+#: emulate's options that a device quirk can set: click parameter -> (EmuOptions field, option name).
+_QUIRK_FIELDS = {"subnormals": ("subnormals", "--subnormals"), "visibility": ("depth", "--depth")}
+
+
+def _refuse_contradictions(selected: list[str], profile: str | None, quirks: tuple[str, ...], **values: object) -> None:
+    """A usage error (exit 2) when an option given on the command line contradicts a selected quirk."""
+    from click.core import ParameterSource
+
+    from .quirks import contradictions
+
+    ctx = click.get_current_context()
+    given = {_QUIRK_FIELDS[p][0]: v for p, v in values.items()
+             if ctx.get_parameter_source(p) not in (ParameterSource.DEFAULT, ParameterSource.DEFAULT_MAP)}
+    options = {field: option for field, option in _QUIRK_FIELDS.values()}
+    for field, quirk, value in contradictions(given, selected):
+        source = f"--device-quirk {quirk}" if quirk in quirks else f"--profile {profile} (quirk {quirk})"
+        raise click.UsageError(f"{options[field]} {given[field]} contradicts {source}, which sets {field} to "
+                               f"{value}: drop one of the two (docs/device-profile.md)")
 
 
 def _progress_bar(frames: int):

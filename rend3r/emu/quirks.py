@@ -2,13 +2,14 @@
 
 Each quirk sets one or more :class:`EmuOptions` fields; ``docs/device-profile.md``
 documents each with its source in the original device's public RTL. A profile is a set
-of quirks; quirks apply after the other options, so they win over, e.g., ``--depth``.
+of quirks; an option given explicitly that a selected quirk would change is refused
+(:func:`contradictions`), never silently overridden.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Iterable
+from typing import Iterable, Mapping
 
 from ..errors import Rend3rError
 from .options import EmuOptions
@@ -69,6 +70,13 @@ def quirk_names(profile: str | None, quirks: Iterable[str]) -> list[str]:
             raise Rend3rError(f"unknown device quirk {name!r}; known: {', '.join(QUIRKS)}")
         chosen.add(name)
     return [n for n in QUIRKS if n in chosen]
+
+
+def contradictions(given: Mapping[str, object], names: Iterable[str]) -> list[tuple[str, str, object]]:
+    """(field, quirk, value) for each quirk that would set a field given explicitly
+    (``given``: EmuOptions field -> value) to a different value."""
+    return [(field, q, value) for q in names for field, value in QUIRKS[q].changes
+            if field in given and given[field] != value]
 
 
 def apply_quirks(options: EmuOptions, names: Iterable[str]) -> EmuOptions:

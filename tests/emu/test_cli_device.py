@@ -83,6 +83,28 @@ def test_profile_and_single_quirks(files):
     assert r.exit_code == 1 and "unknown device quirk 'warp-drive'" in r.output and "Traceback" not in r.output
 
 
+@pytest.mark.parametrize("args, says", [
+    (["--profile", "rend3r-2022", "--subnormals", "ieee"],
+     "--subnormals ieee contradicts --profile rend3r-2022 (quirk flush-subnormals)"),
+    (["--device-quirk", "flush-subnormals", "--subnormals", "ieee"],
+     "--subnormals ieee contradicts --device-quirk flush-subnormals"),
+    (["--profile", "rend3r-2022", "--depth", "painter"],
+     "--depth painter contradicts --profile rend3r-2022 (quirk raster-index-order)"),
+    (["--device-quirk", "raster-index-order", "--depth", "zbuffer"],
+     "--depth zbuffer contradicts --device-quirk raster-index-order"),
+])
+def test_an_explicit_option_contradicting_a_quirk_is_a_usage_error(files, args, says):
+    r = _run(files / "sphere.asm", "-o", files / "c.png", "--size", "32x24", *args)
+    assert r.exit_code == 2 and says in r.output, r.output
+    assert not (files / "c.png").exists()
+
+
+def test_explicit_options_that_agree_with_the_profile_run(files):
+    r = _run(files / "sphere.asm", "-o", files / "a.png", "--size", "32x24", "--profile", "rend3r-2022",
+             "--subnormals", "ftz", "--precision", "fp64")
+    assert r.exit_code == 0, r.output
+
+
 def test_trace_to_stdout_and_file_match_the_worked_vector(files):
     args = [files / "sphere.asm", "-o", files / "t.png", "--device-quirk", "device-camera",
             "--device-quirk", "light0-only", "--trace-pixel", "252,188"]

@@ -8,7 +8,7 @@ import pytest
 
 from rend3r.emu.lighting import fixed_intensity
 from rend3r.emu.options import EmuOptions
-from rend3r.emu.quirks import PROFILES, QUIRKS, apply_quirks, quirk_names
+from rend3r.emu.quirks import PROFILES, QUIRKS, apply_quirks, contradictions, quirk_names
 from rend3r.emu.run import run_program
 from rend3r.errors import Rend3rError
 from rend3r.isa import ShapeSet, Table, encode, lookup
@@ -54,6 +54,14 @@ def test_profile_and_quirk_selection():
         quirk_names("rend3r-1999", [])
     o = apply_quirks(EmuOptions(depth="painter", subnormals="ieee"), quirk_names("rend3r-2022", []))
     assert (o.camera, o.lr_target, o.clear_on_nr, o.depth, o.subnormals) == ("device", 1, False, "index", "ftz")
+
+
+def test_contradictions_name_each_quirk_that_changes_a_given_field():
+    profile = quirk_names("rend3r-2022", [])
+    assert contradictions({"subnormals": "ieee", "depth": "painter"}, profile) == [
+        ("subnormals", "flush-subnormals", "ftz"), ("depth", "raster-index-order", "index")]
+    assert contradictions({"subnormals": "ftz", "depth": "index"}, profile) == []
+    assert contradictions({"subnormals": "ieee"}, ["device-camera"]) == []
 
 
 def test_intensity_converter_wraps_above_a_quarter():

@@ -2,7 +2,8 @@
 
 Traces are JSON lines as ``docs/trace.md`` defines (one value per line). Records are
 matched by (pixel, shape, stage, occurrence), so field order and the interleaving of
-pixels do not matter; values must agree exactly (bits, and the decimal's value).
+pixels do not matter; values must agree exactly (bits, and the decimal's value), except
+that any two NaNs are equal unless ``nan_bits="exact"`` (the device's NaN bits are unknown).
 """
 
 from __future__ import annotations
@@ -12,12 +13,14 @@ import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal
 
 import click
 
 from ..errors import Rend3rError
 
 Key = tuple[int, tuple[int, int], int | None, str, int]
+NanBits = Literal["any", "exact"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -164,19 +167,25 @@ def _keyed(records: list[Record]) -> dict[Key, Record]:
     return out
 
 
-def _same(a: Record, b: Record) -> bool:
+def _same(a: Record, b: Record, nan_bits: NanBits) -> bool:
+    """Equal bits and value; two NaNs (by ``dec``) are equal whatever their bits unless ``nan_bits`` is "exact"."""
     both_nan = math.isnan(a.dec) and math.isnan(b.dec)
+    if both_nan and nan_bits == "any":
+        return True
     return a.bits == b.bits and (both_nan or a.dec == b.dec)
 
 
-def first_divergence(a: list[Record], b: list[Record]) -> str | None:
-    """A message for the first record (in A's order, then B's extras) that differs, or None."""
+def first_divergence(a: list[Record], b: list[Record], nan_bits: NanBits = "any") -> str | None:
+    """A message for the first record (in A's order, then B's extras) that differs, or None.
+
+    ``nan_bits="any"``: a NaN equals any NaN (sign and payload ignored); "exact": bit for bit.
+    """
     ka, kb = _keyed(a), _keyed(b)
     for key, ra in ka.items():
         rb = kb.get(key)
         if rb is None:
             return f"{ra.describe()}: only in A (line {ra.line})"
-        if not _same(ra, rb):
+        if not _same(ra, rb, nan_bits):
             return (
                 f"{ra.describe()}: A 0x{ra.bits:04x} ({ra.dec!r}, line {ra.line}) "
                 f"!= B 0x{rb.bits:04x} ({rb.dec!r}, line {rb.line})"
@@ -190,22 +199,27 @@ def first_divergence(a: list[Record], b: list[Record]) -> str | None:
 @click.command("trace-diff")
 @click.argument("a", type=click.Path(dir_okay=False, path_type=Path))
 @click.argument("b", type=click.Path(dir_okay=False, path_type=Path))
-def trace_diff_command(a: Path, b: Path) -> None:
+@click.option("--nan-bits", type=click.Choice(["any", "exact"]), default="any", show_default=True,
+              help="any: every NaN equals every NaN (the device's NaN bits are unknown); exact: NaNs must "
+                   "agree bit for bit.")
+def trace_diff_command(a: Path, b: Path, nan_bits: NanBits) -> None:
     """Compare two pixel traces (docs/trace.md) and report the first divergence.
 
     Exit status, as cmp and diff: 0 when the traces agree, 1 when they differ, 2 on
-    trouble (a missing, unreadable or malformed file).
+    trouble (a missing, unreadable or malformed file). Any two NaNs are equal unless
+    --nan-bits exact.
 
     \b
     Example:
       rend3r emulate scene.asm -o f.png --trace-pixel 252,188 --trace emu.jsonl
       rend3r trace-diff emu.jsonl rtl.jsonl
+      rend3r trace-diff emu.jsonl softfloat.jsonl --nan-bits exact
     """
     try:
         ra, rb = read_trace(a), read_trace(b)
     except Rend3rError as exc:
         raise Rend3rError(str(exc), exit_code=2) from None
-    msg = first_divergence(ra, rb)
+    msg = first_divergence(ra, rb, nan_bits)
     if msg is None:
         click.echo(f"traces agree: {len(ra)} values")
         return

@@ -93,6 +93,30 @@ def test_lines_split_only_at_newlines(tmp_path):
     assert _diff(tmp_path, line, line).exit_code == 0
 
 
+NAN = LINE.replace('"0x3c00", "dec": 1.0', '"0xfe00", "dec": "nan"')
+
+
+@pytest.mark.parametrize("other, any_code, exact_code", [
+    (NAN, 0, 0),  # the same NaN
+    (NAN.replace("0xfe00", "0x7e00"), 0, 1),  # SoftFloat's default NaN
+    (NAN.replace("0xfe00", "0x7c01"), 0, 1),  # a signalling payload
+    (LINE.replace("0x3c00", "0x7c00").replace("1.0}", '"inf"}'), 1, 1),  # infinity is not a NaN
+    (LINE, 1, 1),
+])
+def test_nans_are_equal_unless_nan_bits_exact(tmp_path, other, any_code, exact_code):
+    a = tmp_path / "a.jsonl"
+    a.write_text(NAN)
+    b = tmp_path / "b.jsonl"
+    b.write_text(other)
+    default = CliRunner().invoke(main, ["trace-diff", str(a), str(b)])
+    assert default.exit_code == any_code, default.output
+    assert CliRunner().invoke(main, ["trace-diff", str(a), str(b), "--nan-bits", "any"]).exit_code == any_code
+    exact = CliRunner().invoke(main, ["trace-diff", str(a), str(b), "--nan-bits", "exact"])
+    assert exact.exit_code == exact_code, exact.output
+    if exact_code:
+        assert "first divergence" in exact.output
+
+
 # --- hypothesis: mutated real traces, deep nesting, huge numbers, wrong types (fixed budget) ---
 
 from hypothesis import HealthCheck, given, settings  # noqa: E402

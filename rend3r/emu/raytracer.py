@@ -1,9 +1,10 @@
 """The raytracer: nearest hit per pixel, diffuse lighting, shadow rays, NaN accounting.
 
-The frame is rendered in bands of rows, so memory stays bounded at any size; each band's
-pixels are split into chunks that threads render with the compiled kernels of
-``csrc/datapath.inc`` (``--jobs``; every pixel is computed the same way whatever the
-split, so the image does not depend on it). Per band:
+The frame is rendered in bands of rows, so memory stays bounded at any size, with the
+compiled kernels of ``csrc/datapath.inc`` on ``--jobs`` threads: bands side by side, a
+band per thread when there are few shapes per pixel, else each band's steps split over
+the threads (every pixel is computed the same way whatever the split, so the image does
+not depend on it). Per band:
 
 1. primary directions and their per-face (u, v) boxes (``directions``);
 2. a grid of the shapes each primary ray must test, front to back by depth floor
@@ -20,7 +21,7 @@ change a pixel; :mod:`.reference` is the plain renderer the tests compare with.
 from __future__ import annotations
 
 from ctypes import byref, pointer
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from time import perf_counter
 from typing import Callable
 
@@ -42,6 +43,11 @@ Progress = Callable[[float], None]
 BAND_PIXELS = native.BAND_LIMIT
 #: Smallest chunk of pixels handed to a thread.
 MIN_CHUNK = 1 << 12
+#: With several threads, a frame of one band is split into a band per thread (each set up
+#: and rendered whole on its thread) when it has at least this many pixels per shape; with
+#: more shapes the per-shape set-up each band repeats would cost more than it saves, and
+#: the band's steps are split over the threads instead.
+PIXELS_PER_SHAPE = 16
 _CHANNELS = ((11, 31), (5, 63), (0, 31))  # RGB565: (shift, largest value) per channel
 
 
@@ -86,10 +92,19 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
         rgb[:], depth[:], prov[:] = options.background, np.inf, -1
     else:
         rows = max(1, BAND_PIXELS // w)
-        for row0 in range(0, h, rows):
-            row1 = min(h, row0 + rows)
-            _band(fr, options, row0, row1, st, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
-                  prov[row0 * w:row1 * w])
+        if fr.jobs > 1 and len(fr.sf) * PIXELS_PER_SHAPE <= n_pix:  # a band per thread at least
+            rows = min(rows, -(-h // fr.jobs))
+        bands = [(row0, min(h, row0 + rows)) for row0 in range(0, h, rows)]
+        if len(bands) == 1:
+            bands[0] = (*bands[0], None)
+        else:  # bands on the threads, their work single-threaded
+            one = replace(fr, jobs=1)
+            bands = [(row0, row1, threads.submit(fr.jobs, _band, one, options, row0, row1,
+                                                 rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
+                                                 prov[row0 * w:row1 * w])) for row0, row1 in bands]
+        for row0, row1, future in bands:
+            _add(st, future.result() if future is not None else _band(
+                fr, options, row0, row1, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w], prov[row0 * w:row1 * w]))
             if progress is not None:
                 progress(row1 / h)
     st.seconds = perf_counter() - start
@@ -216,9 +231,20 @@ def _buckets(cells: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
     return start, items
 
 
-def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, st: FrameStats,
-          rgb: np.ndarray, depth: np.ndarray, prov: np.ndarray) -> None:
-    """Render rows row0..row1 into the band's slices of the frame."""
+def _add(total: FrameStats, band: FrameStats) -> None:
+    """A band's counts added to the frame's."""
+    for name in _BAND_COUNTS:
+        setattr(total, name, getattr(total, name) + getattr(band, name))
+
+
+#: What _band counts.
+_BAND_COUNTS = ("tests", "skipped", "nan_tests", "nan_rays", "hits", "shadow_rays")
+
+
+def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray, depth: np.ndarray,
+          prov: np.ndarray) -> FrameStats:
+    """Render rows row0..row1 into the band's slices of the frame; returns its counts."""
+    st = FrameStats()
     w, n_pix, n, dtype = options.width, (row1 - row0) * options.width, len(fr.sf), fr.dtype
     lit = bool(fr.lights)
     a = {  # the band's arrays; the Band block points into them
@@ -258,6 +284,7 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, st: FrameStats,
                                    native.ptr(rgb, np.uint16, (n_pix,)), native.ptr(depth, np.float32, (n_pix,)),
                                    native.ptr(prov, np.int32, (n_pix,)))
     st.nan_rays += int(a["nan_px"].sum())
+    return st
 
 
 def _pixel_grid(fr: _Frame, row0: int, row1: int) -> tuple[grids.PixelLayout | None, np.ndarray | None]:

@@ -8,7 +8,7 @@ whatever the split, so results never depend on the thread count.
 from __future__ import annotations
 
 import os
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from functools import lru_cache
 from typing import Callable
 
@@ -44,6 +44,11 @@ def balanced(cum: np.ndarray, jobs: int, smallest: int) -> list[tuple[int, int]]
     cuts = np.searchsorted(cum, [total * k // parts for k in range(1, parts)]).tolist()
     edges = sorted({0, m, *(min(max(c, 0), m) for c in cuts)})
     return [(a, b) for a, b in zip(edges, edges[1:])]
+
+
+def submit(jobs: int, fn: Callable[..., object], *args: object) -> Future:
+    """``fn(*args)`` on the pool of ``jobs`` threads."""
+    return _pool(jobs).submit(fn, *args)
 
 
 def each(jobs: int, calls: list[Callable[[], object]]) -> None:

@@ -143,8 +143,9 @@ def check(words: list[int], options: EmuOptions) -> None:
     engine, stats = render_frame(scene, options)
     event(f"pixels hit: {'none' if not stats.hits else 'some' if stats.hits < options.pixels // 4 else 'many'}")
     assert_same(engine, render_reference(scene, options))
-    split, _ = render_frame(scene, replace(options, jobs=3))
-    assert_same(engine, split)
+    for jobs in (1, 3):  # one band on one thread; a band per thread
+        split, _ = render_frame(scene, replace(options, jobs=jobs))
+        assert_same(engine, split)
 
 
 scene_args = (camera, st.lists(light, max_size=3), st.lists(shape, min_size=1, max_size=7),

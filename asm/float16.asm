@@ -5,9 +5,9 @@ cam xloc, 65504                      ; => 0x7bff0801
 cam xloc, 65519.99                   ; => 0x7bff0801
 cam xloc, 65519.999999999            ; => 0x7bff0801
 cam xloc, -65504                     ; => 0xfbff0801
-cam xloc, 65520                      ; error: 65520 overflows float16
-cam xloc, -65520                     ; error: -65520 overflows float16
-cam xloc, 1e999                      ; error: overflows float16
+cam xloc, 65520                      ; => 0x7c000801 ; warning: 65520 overflows float16 to infinity
+cam xloc, -65520                     ; => 0xfc000801 ; warning: -65520 overflows float16 to -infinity
+cam xloc, 1e999                      ; => 0x7c000801 ; warning: overflows float16 to infinity
 cam xloc, 1e99999                    ; error: exponent of '1e99999' is out of range
 cam xloc, 6.103515625e-5             ; => 0x04000801
 cam xloc, 5.96e-8                    ; => 0x00010801

@@ -4,12 +4,14 @@ Numbers are ints or Fractions (integral results are always ints), so ``0.1 * 3``
 exactly 3/10 and rounds to float16 once, at the end. The sign of zero is tracked as
 IEEE 754 does it (``-0``, ``-0 * 5`` and ``-0 + -0`` are negative zero), so ``-0``
 assembles to 0x8000. Raw bits (``0h3c00``) are a value of their own that no arithmetic
-accepts.
+accepts. ``inf``, ``infinity`` and ``nan`` (any case; names no constant has taken) are the
+float values the original assembler's ``float()`` accepted: they may be negated, nothing more.
 """
 
 from __future__ import annotations
 
 import difflib
+import math
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Mapping
@@ -21,10 +23,10 @@ from .parser import MAX_BITS, BinOp, Expr, Neg, Num, Operand, Ref, Str
 class Value:
     """An evaluated operand: a number (with the sign of zero) or raw 16 bits."""
 
-    number: int | Fraction = 0
+    number: int | Fraction | float = 0  # a float only for inf and nan
     negative_zero: bool = False
     raw: int | None = None  # set for 0h literals: the bits, and number is unused
-    hex_literal: bool = False  # the operand was exactly one 0x literal
+    literal: str = ""  # "hex" or "bin": the operand was exactly one 0x or 0b literal
 
     @property
     def is_integer(self) -> bool:
@@ -38,6 +40,8 @@ class Value:
 #: The value of a constant whose definition failed: using it fails without a second
 #: message (the definition's error already explains it).
 POISON = Value()
+#: Names of the non-finite values (lower case), as Python's ``float()`` spells them.
+NON_FINITE = {"inf": math.inf, "infinity": math.inf, "nan": math.nan}
 
 
 class EvalError(Exception):
@@ -58,17 +62,24 @@ def evaluate(node: Expr | Str, env: Mapping[str, Value]) -> Value:
             raise EvalError(node.error, node.col, node.end)
         if node.kind == "raw":
             return Value(raw=node.value)
-        return Value(node.value, negative_zero=node.negative_zero, hex_literal=node.kind == "hex")
+        return Value(node.value, negative_zero=node.negative_zero,
+                     literal=node.kind if node.kind in ("hex", "bin") else "")
     if cls is Ref:
         try:
             value = env[node.name]
         except KeyError:
-            raise EvalError(_undefined(node.name, env), node.col, node.end) from None
+            special = NON_FINITE.get(node.name.lower())
+            if special is None:
+                raise EvalError(_undefined(node.name, env), node.col, node.end) from None
+            return Value(special)
         if value is POISON:
             raise EvalError("", node.col, node.end)
         return value
     if cls is Neg:
-        v = _number(evaluate(node.operand, env), node.operand)
+        v = evaluate(node.operand, env)
+        if type(v.number) is float:
+            return Value(-v.number)  # -nan keeps its sign bit, as float("-nan") does
+        v = _number(v, node.operand)
         return Value(-v.number, negative_zero=v.number == 0 and not v.negative_zero)
     if cls is BinOp:
         a = _number(evaluate(node.left, env), node.left)
@@ -80,6 +91,8 @@ def evaluate(node: Expr | Str, env: Mapping[str, Value]) -> Value:
 def _number(v: Value, node: Expr) -> Value:
     if v.raw is not None:
         raise EvalError("raw bits (0h...) cannot be used in arithmetic", node.col, node.end)
+    if type(v.number) is float:
+        raise EvalError("inf and nan cannot be used in arithmetic (only negated)", node.col, node.end)
     return v
 
 

@@ -74,8 +74,8 @@ def _float_bits(text: str) -> int | None:
     if bits != -1:
         return bits
     c = text[:2].lower()
-    if c == "0x":
-        bits = None  # a 0x literal for a float property gets a warning
+    if c == "0x" or c == "0b" and int(text, 2) >= 0x8000:
+        bits = None  # a warning follows: 0x literals, and 0b ones read as signed
     elif c == "0h":
         bits = int(text[2:], 16)
     else:

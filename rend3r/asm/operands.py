@@ -15,11 +15,12 @@ from typing import Mapping, Protocol
 
 from ..isa.encoding import CameraSet, FrameOp, LightSet, ShapeSet, encode
 from ..isa.extensions import EXTENSIONS, table_select_word
-from ..isa.float16 import Rounded, round_literal, shortest_repr
+from ..isa.float16 import Rounded, float_to_bits, round_literal, shortest_repr
 from ..isa.tables import (
     F_MNEMONICS,
     LIGHT_INDEX_LIMIT,
     MNEMONIC_TABLE,
+    ORIGINAL_NAMES,
     PROPERTIES,
     SHAPE_INDEX_LIMIT,
     Property,
@@ -173,7 +174,7 @@ class OperandEncoder:
         if not isinstance(node, Ref):
             host.error(f"expected a {table.value} property name, got '{host.source(node)}'", node.col, node.end)
             return None
-        prop = lookup(table, node.name)
+        prop = lookup(table, node.name) or ORIGINAL_NAMES[table].get(node.name.lower())
         if prop is not None:
             return prop
         reg = _REGISTER.fullmatch(node.name)
@@ -214,30 +215,43 @@ class OperandEncoder:
         return v.number
 
     def float_bits(self, prop: Property, v: Value, node: Operand, src: str) -> int | None:
+        """float16 bits of ``v`` as the original assembler gave them, with a warning where
+        the source likely meant something else."""
         host = self.host
-        if v.hex_literal:
+        number = v.number
+        if type(number) is float:  # inf or nan, written as such
+            return float_to_bits(number)
+        if v.literal and 0x8000 <= number <= 0xFFFF:
+            number -= 0x10000
             host.warning(
-                f"{src} is the integer {describe(v.number)} for float16 property '{prop.name}'; "
+                f"{src} is read as the signed 16-bit integer {number} for float16 property '{prop.name}' "
+                f"(as the original assembler did); write 0h{v.number:04x} for raw bits",
+                node.col,
+                node.end,
+            )
+        elif v.literal == "hex" and number <= 0xFFFF:
+            host.warning(
+                f"{src} is the integer {describe(number)} for float16 property '{prop.name}'; "
                 f"write 0h{src[2:].replace('_', '').lower()} for raw bits",
                 node.col,
                 node.end,
             )
-        if v.number and not v.negative_zero:
+        if number and not v.negative_zero:
             try:
-                bits = half_bits(float(v.number))  # quick when no diagnostic can follow
+                bits = half_bits(float(number))  # quick when no diagnostic can follow
             except OverflowError:
                 bits = None
             if bits is not None:
                 return bits
-        key = (v.number, v.negative_zero)
+        key = (number, v.negative_zero)
         r = self.rounded.get(key)
         if r is None:
-            r = self.rounded[key] = round_literal(v.number, negative=v.negative_zero)
+            r = self.rounded[key] = round_literal(number, negative=v.negative_zero)
         if r.overflow:
-            host.error(f"{src} overflows float16 (magnitude must be below 65520; largest finite is 65504)",
-                       node.col, node.end)
-            return None
-        if r.underflow:
+            host.warning(f"{src} overflows float16 to {'-' if number < 0 else ''}infinity (magnitudes of 65520 "
+                         f"and above do; the largest finite is 65504); write inf if infinity is meant",
+                         node.col, node.end)
+        elif r.underflow:
             host.warning(f"{src} underflows to zero in float16 (smallest subnormal is 2^-24, about 5.96e-08)",
                          node.col, node.end)
         elif r.relative_error > 0.01:

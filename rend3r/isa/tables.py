@@ -210,6 +210,14 @@ LIGHT_SOURCE_CODES = {name: code for code, name in LIGHT_SOURCES.items()}
 SHAPE_TYPE_CODES = {name: code for code, name in SHAPE_TYPES.items()}
 
 
+#: Unused slots the original device's Python assembler (in its public repository) still
+#: named, so its sources can use them: writable like a float16 property, ignored by
+#: the device. Not in ``PROPERTIES``: the decoder, disassembler and emulator know no such
+#: property, and ``aN`` does not name them.
+ORIGINAL_NAMES: dict[Table, dict[str, Property]] = {t: {} for t in Table}
+ORIGINAL_NAMES[Table.TRIANGLE]["none"] = Property(10, "none", "unused", ValueType.FLOAT16)
+
+
 def by_index(table: Table) -> dict[int, Property]:
     """Properties of ``table`` keyed by index (gaps such as triangle 10 are absent)."""
     return _BY_INDEX[table]

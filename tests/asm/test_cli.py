@@ -72,7 +72,7 @@ def test_errors_exit_1_and_write_nothing(tmp_path: Path):
 
 def test_existing_output_untouched_on_error(tmp_path: Path):
     bad = tmp_path / "bad.asm"
-    bad.write_text("cam xloc, 70000\ner\ner\n")
+    bad.write_text("cam xloc, 1 / 0\ner\ner\n")
     out = tmp_path / "keep.mem"
     out.write_text("old\n")
     assert run(str(bad), "-o", str(out)).exit_code == 1

@@ -179,7 +179,9 @@ class OperandEncoder:
             return prop
         reg = _REGISTER.fullmatch(node.name)
         if reg:
-            host.error(f"the {table.value} table has no property {reg.group(1)}", node.col, node.end)
+            named = [n for n, p in ORIGINAL_NAMES[table].items() if p.index == int(reg.group(1))]
+            hint = f" (its unused slot {reg.group(1)} is named '{named[0]}')" if named else ""
+            host.error(f"the {table.value} table has no property {reg.group(1)}{hint}", node.col, node.end)
             return None
         names = [n for p in PROPERTIES[table] for n in (p.name, *p.extra_names)]
         close = difflib.get_close_matches(node.name.lower(), names, n=1)

@@ -68,6 +68,8 @@ def test_none_names_triangle_slot_10_only():
     assert r.program.words[:4] == [0x0000505D, 0x3C004000, 0x0000505D, 0x3C004000]
     for line in ("sp 3, none, xloc, 1, 2", "cam none, 1", "lt 0, none, 1", "tr 3, a10, x1, 1, 2"):
         assert not assemble_source(line + "\ner\ner\n").ok, line
+    a10 = assemble_source("tr 3, a10, x1, 1, 2\ner\ner\n").errors[0].message
+    assert a10 == "the triangle table has no property 10 (its unused slot 10 is named 'none')"
 
 
 def test_inf_and_nan_are_values_only_where_no_constant_is():

@@ -7,6 +7,22 @@ import numpy as np
 from rend3r.isa import CameraSet, FrameOp, Func, LightSet, ShapeSet, Table, ValueType, encode, lookup
 
 
+#: A lit sphere in front of a narrow camera: the smallest program with a shadowless hit.
+ONE_SPHERE = """\
+nr
+cam hfov, 0.3
+cam vfov, 0.3
+lt 0, src, 1
+lt 0, zfor, -1
+sp 0, type, col, 1, 0xF800
+sp 0, zloc, rrot, -3, 1
+sp 0, xscl, yscl, 1, 1
+sp 0, zscl, zero, 1, 0
+nf
+er
+"""
+
+
 def f16(value: float) -> int:
     return int(np.array(value, dtype=np.float16).view(np.uint16))
 

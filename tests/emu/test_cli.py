@@ -10,21 +10,8 @@ from rend3r.emu.image import rgb565_to_rgb888
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.run import run_program
 
-from .scenes import Prog
+from .scenes import ONE_SPHERE as SRC, Prog
 
-SRC = """\
-nr
-cam hfov, 0.3
-cam vfov, 0.3
-lt 0, src, 1
-lt 0, zfor, -1
-sp 0, type, col, 1, 0xF800
-sp 0, zloc, rrot, -3, 1
-sp 0, xscl, yscl, 1, 1
-sp 0, zscl, zero, 1, 0
-nf
-er
-"""
 
 
 def _run(*args, **kw):

@@ -122,19 +122,9 @@ def test_nans_are_equal_unless_nan_bits_exact(tmp_path, other, any_code, exact_c
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
-SCENE = """nr
-cam hfov, 0.3
-cam vfov, 0.3
-lt 0, src, 1
-lt 0, zfor, -1
-sp 0, type, col, 1, 0xF800
-sp 0, zloc, rrot, -3, 1
-sp 0, xscl, yscl, 1, 1
-sp 0, zscl, zero, 1, 0
-nf
-er
-er
-"""
+from .scenes import ONE_SPHERE  # noqa: E402
+
+SCENE = ONE_SPHERE + "er\n"  # two er: the end the device needs
 
 
 @pytest.fixture(scope="module")

@@ -6,8 +6,10 @@
 ;         does not change, but the green sphere passes in front of and behind it.
 ; Run:    rend3r emulate programs/animation.asm --frames 8 -o 'anim_{n:03}.png'
 ;         (or --gif anim.gif)
-; Look:   frame 0: green sphere to the right of the red one; frame 2: in front of it
-;         (larger, covering it); frame 4: to the left; frame 6: hidden behind it.
+; Look:   frame 0: the small green sphere to the right of the red one; frame 2: in front
+;         of it, larger, covering all but a thin red rim; frame 4: to the left; frame 6:
+;         hidden behind it. In fp16 (the default) the green sphere's edge is ragged where
+;         it is far and small (frames 0, 4, 5 and 7); --precision fp64 draws it smooth.
 ; frames: 8
 
 R = 2.2                          ; orbit radius

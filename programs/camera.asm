@@ -7,8 +7,11 @@
 ;         ahead (it cuts into the nearest sphere) and the far clip 13, so the spheres
 ;         beyond 13 units are not drawn.
 ; Run:    rend3r emulate programs/camera.asm -o camera.png
-; Look:   three orange-to-yellow spheres shrinking into the distance from the lower left
-;         towards the centre; the two farther spheres are cut away by the far clip plane.
+; Look:   orange-to-yellow spheres in a row from the lower left towards the centre. The
+;         nearest, cut open by the near clip plane, shows only a thin lit crescent along
+;         its upper and right edge (its inside is black); the next two are whole and
+;         shrink into the distance; the two beyond the far clip plane are not drawn. In
+;         fp16 the edges of the two whole spheres are ragged; fp64 draws them smooth.
 ; frames: 1
 
 nr

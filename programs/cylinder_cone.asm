@@ -6,7 +6,8 @@
 ; Run:    rend3r emulate programs/cylinder_cone.asm -o cylinder_cone.png
 ; Look:   on the left a green vertical band (the cylinder, radius 0.6) running off the top
 ;         and bottom of the screen; on the right an orange hourglass (the double cone,
-;         apex at the centre height, opening 1:2). Both lit from the right.
+;         apex at the centre height, opening 1:2). Both lit from the right. In fp16 the
+;         cone's apex is a ragged notch of stair steps; fp64 draws a sharp point.
 ; frames: 1
 
 C45 = 0.70710678                ; cos 45 = sin 45

@@ -6,8 +6,9 @@
 ;         significand leaves few or no correct bits. Left: a sphere at S = 16; right: one
 ;         at S = 32. A very narrow field of view (0.03 of the default) makes them large.
 ; Run:    rend3r emulate programs/fp16_cancel.asm -o fp16_cancel.png
-; Look:   fp16: ragged, blocky silhouettes and shading in coarse bands, the right sphere
-;         far worse than the left; fp32/fp64: two smooth shaded spheres.
+; Look:   fp16: each sphere broken into vertical crescent-shaped slices with black gaps
+;         between them, each slice shaded flat, the right (blue) sphere far worse than the
+;         left (orange); fp32/fp64: two smooth shaded spheres.
 ; frames: 1
 
 nr

@@ -8,8 +8,10 @@
 ;         fp16_underflow.asm).
 ; Run:    rend3r emulate programs/fp16_distance.asm -o fp16_distance.png
 ;         (compare --precision fp32, which draws all three)
-; Look:   fp16: the left sphere whole; of the middle one only a central disc (the part
-;         nearer than 256 units); the right one missing. fp32/fp64: three whole spheres.
+; Look:   fp16: the left sphere whole, with a ragged top edge and faint seams where its
+;         shading steps; of the middle one only a central disc (the part nearer than 256
+;         units) with a square patch at its middle; the right one missing. fp32/fp64:
+;         three whole spheres.
 ; frames: 1
 
 nr

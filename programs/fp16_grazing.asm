@@ -12,8 +12,9 @@
 ; Run:    rend3r emulate programs/fp16_grazing.asm -o fp16_grazing.png
 ; Look:   a lavender pipe running from the lower right corner into the centre; an
 ;         orange hourglass pinched to a point at the upper left, its far nappe a disc
-;         around the centre. In fp16 a thin ring of that far nappe, more than 256 units
-;         away, is black (see fp16_distance.asm).
+;         around the centre. In fp16 that disc's right and lower rim, more than 256 units
+;         away, is missing (black; see fp16_distance.asm), and a few single pixels on the
+;         surfaces are black.
 ; frames: 1
 
 nr

@@ -9,8 +9,9 @@
 ;         --subnormals ieee the subnormals keep enough bits and the disc stays round.
 ; Run:    rend3r emulate programs/fp16_underflow.asm -o fp16_underflow.png
 ;         (compare --subnormals ieee and --precision fp64)
-; Look:   fp16 ftz: a purple disc with a cross of wider bands through its centre, square
-;         corners where both squares vanish; fp16 ieee and fp64: a round disc.
+; Look:   fp16 ftz: not a disc but a purple square with stepped corners, two overlapping
+;         rectangles (a cross of wider bands through the centre): where both squared
+;         components vanish the corners stay square; fp16 ieee and fp64: a round disc.
 ; frames: 1
 
 nr

@@ -11,7 +11,8 @@
 ;         rend3r svo render torus.svo --with-program programs/hybrid.asm --place 0,0,-4,1 -o hybrid.png
 ; Look:   alone: a grey floor curving away below a black sky, a blue sphere left of
 ;         centre and a smaller red one at the front right, each with its shadow on the
-;         floor; merged: the torus stands in the middle, in front of the blue sphere.
+;         floor (in fp16 the red sphere's right edge is ragged); merged: the torus stands
+;         in the middle, in front of the blue sphere.
 ; frames: 1
 
 nr

@@ -10,7 +10,7 @@
 ; Run:    rend3r emulate programs/hybrid_mix.asm --mode hybrid -o hybrid_mix.png
 ; Look:   a grey triangle floor ending in a straight far edge, the orange front face of
 ;         the pyramid, the red sphere half hidden behind it where it pierces the face, the
-;         small blue sphere in front at the right.
+;         small blue sphere in front at the right (in fp16 its lower edge is ragged).
 ; frames: 1
 ; mode: hybrid
 

@@ -5,9 +5,11 @@
 ;         of the spheres at half intensity, and light 3 switched off (src 0) with full
 ;         white intensity to show that an off light adds nothing.
 ; Run:    rend3r emulate programs/lights.asm -o lights.png
-; Look:   three white spheres in a row: red on their left flanks, blue on their right
-;         flanks, a green highlight on their tops that is strongest on the middle sphere
-;         (closest to the point light); where two lights overlap the colours add.
+; Look:   three white spheres in a row, each red on its left and blue on its right,
+;         purple between; the green point light tints their tops (teal over blue, yellow
+;         over red). The middle sphere shades its neighbours' inner flanks from the side
+;         lights: the left sphere's right edge and the right sphere's left edge lie beyond
+;         a straight vertical shadow line, lit dark green by the point light alone.
 ; frames: 1
 
 nr

@@ -5,7 +5,8 @@
 ;         the small sphere's centre onto the big sphere's centre.
 ; Run:    rend3r emulate programs/shadow.asm -o shadow.png
 ; Look:   a big blue disc lit from the upper right with a round black shadow on its face,
-;         down and to the left of the small yellow disc that casts it.
+;         down and to the left of the small yellow disc that casts it (in fp16 the yellow
+;         disc's right edge is ragged).
 ; frames: 1
 
 nr

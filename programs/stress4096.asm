@@ -9,9 +9,11 @@
 ;         spheres would lose most of them to float16 cancellation in the quadratic (see
 ;         docs/numerics.md and fp16_cancel.asm).
 ; Run:    rend3r emulate programs/stress4096.asm -o stress4096.png --stats
-; Look:   an 8 x 8 block of shaded beads lit from the upper right, blue at the lower
-;         left, magenta to the right, cyan to the top; through the gaps between them
-;         the spheres behind recede in perspective.
+; Look:   an 8 x 8 block of shaded beads lit from the upper right: blue at the lower
+;         left, magenta at the lower right, cyan at the upper left, pale lavender at the
+;         upper right; slivers of the spheres behind show through the gaps. In fp16 every
+;         bead's edge is ragged and its face hatched with diagonal streaks; fp64 draws
+;         them smooth.
 ; frames: 1
 ; test-size: 64x48
 

@@ -7,8 +7,13 @@
 ;         sum of the two, to show the emulator uses the given q as is). Right: a cone
 ;         turned 45 degrees about z then 90 about x.
 ; Run:    rend3r emulate programs/transforms.asm -o transforms.png
-; Look:   a magenta lozenge tilted up to the right; a cyan band leaning across the middle;
-;         a white double cone; all lit from the upper left.
+; Look:   the white double cone dominates: its near nappe a bright fan opening to the
+;         lower right from an apex right of centre (frayed in fp16), its far nappe almost
+;         black over the upper left, with a faint grey wedge running up to the top edge;
+;         a cyan rod leans up from the bottom edge, left of the apex. The magenta
+;         ellipsoid at the left does not show: the far nappe hides its upper half and its
+;         lower half faces away from the light (from the upper left), so it is black on
+;         black.
 ; frames: 1
 
 nr

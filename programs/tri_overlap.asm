@@ -5,9 +5,11 @@
 ;         green over red; a blue triangle tilted in depth (z from -3 to -7) pierces both.
 ;         The two triangles sharing the edge at the bottom are given in opposite windings.
 ; Run:    rend3r emulate programs/tri_overlap.asm --mode raster -o tri_overlap.png
-; Look:   red in front of green where they overlap; the blue sliver, slanting away to
-;         the right, passes behind the red triangle but in front of the green one; a
-;         yellow/cyan pair of triangles at the bottom joined without a gap.
+; Look:   red in front of green where they overlap; the blue sliver, narrow at the left
+;         screen edge and widening to the right as it tilts away, passes behind the red
+;         triangle and in front of the green one until it pierces it near the green one's
+;         right edge (a short stretch of blue hidden there); a yellow/cyan pair of
+;         triangles at the bottom joined without a gap.
 ; frames: 1
 ; mode: raster
 

@@ -7,7 +7,8 @@
 ;         from its ring (red up, blue down the rings) and segment (green around).
 ; Run:    rend3r emulate programs/tri_sphere.asm --mode raster -o tri_sphere.png
 ; Look:   a faceted ball of flat-shaded quads, bluish at the top and dark red at the
-;         bottom, lit from the upper right, with no holes between facets.
+;         bottom, lit from the upper right, with no holes between facets; its lower-left
+;         quarter faces away from the light and is black, so the ball looks cut away there.
 ; frames: 1
 ; mode: raster
 

@@ -4,7 +4,11 @@ never sees a half-written file, and a failed write leaves nothing behind), and a
 command's outputs are all or nothing (:class:`Outputs`): every output is checked before
 any work, staged under a hidden name beside its target, and renamed into place only when
 the whole run has succeeded; when anything fails first, the staged files and the folders
-the run created are removed and every file it would have replaced is left as it was."""
+the run created are removed and every file it would have replaced is left as it was.
+
+One rule for every command's outputs: missing parent folders are created (and removed
+again when the write fails); an output that cannot be written is refused with
+``cannot write PATH: reason`` (:func:`check_writable`)."""
 
 from __future__ import annotations
 
@@ -49,19 +53,23 @@ def write_atomic(path: str | os.PathLike[str], data: bytes) -> None:
     """Write ``data`` to ``path`` atomically.
 
     The bytes go to a temporary file in the same directory, are flushed and fsynced, and
-    the file is renamed over ``path`` with :func:`os.replace`. On any failure the temporary
-    file is removed, ``path`` is left as it was, and a :class:`Rend3rError` is raised.
+    the file is renamed over ``path`` with :func:`os.replace`. Missing parent folders are
+    created first. On any failure the temporary file and the folders made are removed,
+    ``path`` is left as it was, and a :class:`Rend3rError` is raised.
     A new file gets the mode a plain ``open(path, "wb")`` would give it; an existing
     file keeps its mode.
     """
     target = Path(path)
     directory = target.parent
+    check_writable(target)
+    made = make_folders(target)
     tmp = directory / f".rend3r-{secrets.token_hex(6)}.tmp"  # short: any target name fits
     try:
         # 0o666 filtered by the umask, as for an ordinary new file.
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
     except OSError as exc:
-        raise Rend3rError(f"{target}: cannot write: {exc.strerror or exc}") from exc
+        remove_folders(made)
+        raise Rend3rError(f"cannot write {target}: {exc.strerror or exc}") from exc
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
@@ -71,10 +79,83 @@ def write_atomic(path: str | os.PathLike[str], data: bytes) -> None:
         os.replace(tmp, target)
     except BaseException as exc:
         tmp.unlink(missing_ok=True)
+        remove_folders(made)
         if isinstance(exc, OSError):
-            raise Rend3rError(f"{target}: cannot write: {exc.strerror or exc}") from exc
+            raise Rend3rError(f"cannot write {target}: {exc.strerror or exc}") from exc
         raise
     _fsync_directory(directory)
+
+
+def check_writable(path: str | os.PathLike[str]) -> None:
+    """Refuse, with ``cannot write PATH: reason``, an output that cannot be written: a name
+    with a NUL byte or a part too long, a folder in its place, or its nearest existing
+    ancestor folder a file or not writable. Missing folders in between are fine: they are
+    made when the file is written (:func:`make_folders`)."""
+    p = Path(path)
+    if "\0" in str(p):
+        raise Rend3rError(f"cannot write {str(p)!r}: a file name cannot hold a NUL byte")
+    folder = p.parent
+    while not os.path.lexists(folder) and folder != folder.parent:
+        folder = folder.parent
+    longest = _name_max(folder)
+    for part in p.parts:
+        if len(os.fsencode(part)) > longest:
+            raise Rend3rError(f"cannot write {p}: a name in it is longer than {longest} bytes")
+    try:
+        if p.is_dir():
+            raise Rend3rError(f"cannot write {p}: it is a folder")
+        if not folder.is_dir():
+            raise Rend3rError(f"cannot write {p}: {folder} is not a folder")
+    except OSError as exc:
+        raise Rend3rError(f"cannot write {p}: {exc.strerror or exc}") from None
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise Rend3rError(f"cannot write {p}: folder {folder} is not writable")
+
+
+def make_folders(path: str | os.PathLike[str]) -> list[Path]:
+    """Create the missing folders above the file ``path``, outermost first, and return them
+    (for :func:`remove_folders`); on failure remove those made and raise ``cannot write``."""
+    p = Path(path)
+    missing = []
+    folder = p.parent
+    while not os.path.lexists(folder) and folder != folder.parent:
+        missing.append(folder)
+        folder = folder.parent
+    made: list[Path] = []
+    for f in reversed(missing):
+        try:
+            f.mkdir()
+        except OSError as exc:
+            remove_folders(made)
+            raise Rend3rError(f"cannot write {p}: cannot create folder {f}: {exc.strerror or exc}") from None
+        made.append(f)
+    return made
+
+
+def make_output_folder(path: str | os.PathLike[str]) -> Path:
+    """Make sure the output folder ``path`` exists, creating it and its parents, for the
+    commands that write a folder of files; ``cannot write PATH: reason`` otherwise."""
+    p = Path(path)
+    if os.path.lexists(p) and not p.is_dir():
+        raise Rend3rError(f"cannot write {p}: it is a file, not a folder")
+    if not p.is_dir():
+        check_writable(p)
+        try:
+            p.mkdir(parents=True)
+        except OSError as exc:
+            raise Rend3rError(f"cannot write {p}: {exc.strerror or exc}") from None
+    elif not os.access(p, os.W_OK | os.X_OK):
+        raise Rend3rError(f"cannot write {p}: folder {p} is not writable")
+    return p
+
+
+def remove_folders(made: list[Path]) -> None:
+    """Remove folders listed outermost first (innermost first, each only if still empty)."""
+    for folder in reversed(made):
+        try:
+            folder.rmdir()
+        except OSError:
+            pass
 
 
 def _keep_mode(target: Path, tmp: Path) -> None:
@@ -108,46 +189,22 @@ class Outputs:
         self._staged: dict[Path, Path] = {}  # target -> staged file
         self._made: list[Path] = []  # folders this run created, parents first
 
-    def reserve(self, path: str | os.PathLike[str], *, make_parents: bool = False) -> Path:
-        """Check now that ``path`` can be written: named once, not a folder, its folder
-        existing (or creatable when ``make_parents``) and writable. Rend3rError otherwise."""
+    def reserve(self, path: str | os.PathLike[str]) -> Path:
+        """Check now that ``path`` can be written (:func:`check_writable`) and is named once."""
         p = Path(path)
         key = os.path.abspath(p)  # no file system access: safe before the checks
         if key in self._reserved:
             raise Rend3rError(f"{p}: named by two outputs of this run")
-        try:
-            self._check(p, make_parents)
-        except OSError as exc:
-            raise Rend3rError(f"{p}: cannot write: {exc.strerror or exc}") from None
+        check_writable(p)
         self._reserved[key] = p
         return p
-
-    @staticmethod
-    def _check(p: Path, make_parents: bool) -> None:
-        if "\0" in str(p):
-            raise Rend3rError(f"{str(p)!r}: cannot write: a file name cannot hold a NUL byte")
-        folder = p.parent
-        while make_parents and folder != folder.parent and not folder.exists():
-            folder = folder.parent
-        longest = _name_max(folder)
-        for part in p.parts:
-            if len(os.fsencode(part)) > longest:
-                raise Rend3rError(f"{p}: cannot write: a name in it is longer than {longest} bytes")
-        if p.is_dir():
-            raise Rend3rError(f"{p}: cannot write: it is a folder")
-        if not folder.exists():
-            raise Rend3rError(f"{p}: folder {p.parent} does not exist")
-        if not folder.is_dir():
-            raise Rend3rError(f"{p}: cannot write: {folder} is not a folder")
-        if not os.access(folder, os.W_OK | os.X_OK):
-            raise Rend3rError(f"{p}: cannot write: folder {folder} is not writable")
 
     def write(self, path: str | os.PathLike[str], data: bytes) -> None:
         """Stage ``data`` for ``path`` (reserved or not); it appears there at :meth:`commit`."""
         p = Path(path)
         if os.path.abspath(p) not in self._reserved:
-            self.reserve(p, make_parents=True)
-        self._make_folders(p.parent)
+            self.reserve(p)
+        self._made += make_folders(p)
         old = self._staged.pop(p, None)
         if old is not None:
             old.unlink(missing_ok=True)
@@ -170,7 +227,7 @@ class Outputs:
                 except OSError as exc:
                     if isinstance(backup, Path):
                         backup.unlink(missing_ok=True)
-                    raise Rend3rError(f"{target}: cannot write: {exc.strerror or exc}") from None
+                    raise Rend3rError(f"cannot write {target}: {exc.strerror or exc}") from None
                 done.append((target, backup))
         except BaseException:
             for target, backup in reversed(done):
@@ -188,11 +245,7 @@ class Outputs:
         for stage in self._staged.values():
             stage.unlink(missing_ok=True)
         self._staged.clear()
-        for folder in reversed(self._made):
-            try:
-                folder.rmdir()
-            except OSError:
-                pass
+        remove_folders(self._made)
         self._made.clear()
 
     def __enter__(self) -> Outputs:
@@ -201,18 +254,6 @@ class Outputs:
     def __exit__(self, kind, value, tb) -> None:
         if kind is not None:
             self.abort()
-
-    def _make_folders(self, folder: Path) -> None:
-        missing = []
-        while not folder.exists() and folder != folder.parent:
-            missing.append(folder)
-            folder = folder.parent
-        for f in reversed(missing):
-            try:
-                f.mkdir()
-            except OSError as exc:
-                raise Rend3rError(f"cannot create folder {f}: {exc.strerror or exc}") from None
-            self._made.append(f)
 
 
 def _name_max(folder: Path) -> int:

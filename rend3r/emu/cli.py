@@ -45,10 +45,11 @@ def _pattern(ctx, param, value: str | None) -> str | None:
 
 @click.command("emulate", epilog=_EPILOG)
 @click.argument("program", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", callback=_pattern, help="PNG per frame: a name, or a pattern like out/frame_{n:03}.png for several "
-              "(a pattern's folders are created; a plain name's folder must exist). Only {n} may appear in braces, "
-              "with at most a zero-padded width; write a literal brace as {{ or }}.")
-@click.option("--frames", type=click.IntRange(min=1), help="Render at most N frames (required for programs that loop with lr).")
+@click.option("-o", "--output", callback=_pattern, metavar="PATTERN",
+              help="PNG per frame: a file name, or a pattern like out/frame_{n:03}.png for several (missing folders "
+              "are made). Only {n} may appear in braces, with at most a zero-padded width; write a literal brace "
+              "as {{ or }}.")
+@click.option("--frames", type=click.IntRange(min=1), metavar="N", help="Render at most N frames (required for programs that loop with lr).")
 @click.option("--mode", type=click.Choice(["raytrace", "raster", "hybrid"]), help="How SE/SD data is read (default: from the source's sp/tr, else raytrace); hybrid: shapes and triangles in one frame (docs/isa-extensions.md).")
 @click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormals: flush to zero (the device's IP) or IEEE gradual underflow.")
@@ -56,15 +57,15 @@ def _pattern(ctx, param, value: str | None) -> str | None:
 @click.option("--background", default="0x0000", show_default=True, callback=_colour, help="RGB565 colour where no shape is hit.")
 @click.option("--depth", "visibility", type=click.Choice(["zbuffer", "painter"]), default="zbuffer", show_default=True,
               help="Raster visibility: a depth buffer, or the paper's painter order by centroid distance.")
-@click.option("--depth-image", "depth_path", callback=_pattern, help="Depth image per frame: .npy (float32 distances) or 16-bit PNG.")
-@click.option("--provenance", "prov_path", callback=_pattern, help="Which shape made each pixel: .npy (int32, -1 none) or PNG.")
-@click.option("--gif", "gif_path", help="All frames as an animated GIF.")
-@click.option("--apng", "apng_path", help="All frames as an animated PNG (lossless; .png or .apng).")
+@click.option("--depth-image", "depth_path", callback=_pattern, metavar="PATTERN", help="Depth image per frame: .npy (float32 distances) or 16-bit PNG.")
+@click.option("--provenance", "prov_path", callback=_pattern, metavar="PATTERN", help="Which shape made each pixel: .npy (int32, -1 none) or PNG.")
+@click.option("--gif", "gif_path", metavar="FILE", help="All frames as an animated GIF.")
+@click.option("--apng", "apng_path", metavar="FILE", help="All frames as an animated PNG (lossless; .png or .apng).")
 @click.option("--stats", "show_stats", is_flag=True, help="Print counters, times and the paper's device estimate.")
 @click.option("--profile", type=click.Choice(["rend3r-2022"]), help="Model the original board: every device quirk (docs/device-profile.md).")
 @click.option("--device-quirk", "quirks", multiple=True, metavar="NAME", help="Switch on one device quirk (repeatable); names in docs/device-profile.md.")
 @click.option("--trace-pixel", "trace_pixels", multiple=True, metavar="X,Y", help="Trace every float16 intermediate of this pixel (repeatable; docs/trace.md).")
-@click.option("--trace", "trace_path", help="Write pixel traces (JSON lines) to FILE instead of standard output.")
+@click.option("--trace", "trace_path", metavar="FILE", help="Write pixel traces (JSON lines) to FILE instead of standard output.")
 @JOBS
 @MAX_MEMORY
 def emulate_command(program, output, frames, mode, precision, subnormals, size, background, visibility,
@@ -133,7 +134,7 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
     for path in (output, depth_path, prov_path):
         if path:
             for n in range(count) if is_pattern(path) else (0,):
-                outputs.reserve(frame_path(path, n), make_parents=is_pattern(path))
+                outputs.reserve(frame_path(path, n))
     for path in (animate, trace_path):
         if path:
             outputs.reserve(path)

@@ -43,14 +43,12 @@ def render_all(
     Returns the names of the programs that failed.
     """
     from ..emu.image import save_png
+    from ..fileio import make_output_folder
 
     paths = program_paths(programs_dir)
     if not paths:
         raise Rend3rError(f"no *.asm programs in {programs_dir}")
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise Rend3rError(f"{out_dir}: cannot create the output folder: {exc.strerror or exc}") from None
+    make_output_folder(out_dir)
     failed: list[str] = []
     for n, path in enumerate(paths, 1):
         prefix = f"[{n}/{len(paths)}] {path.stem}:"
@@ -76,14 +74,15 @@ def render_all(
 
 @click.command("render-all")
 @click.argument("programs_dir", type=click.Path(path_type=Path, file_okay=False), default="programs")
-@click.option("-o", "--out", "out_dir", type=click.Path(path_type=Path, file_okay=False), required=True, help="Folder for the PNGs.")
+@click.option("-o", "--output", "out_dir", type=click.Path(path_type=Path), required=True, metavar="DIR",
+              help="Folder for the PNGs (made if missing).")
 @click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormal handling.")
 @click.option("--size", type=SIZE, default="512x384", show_default=True, help="Image size (1..8192 each).")
 @JOBS
 def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnormals: str, size: tuple[int, int],
                        jobs: int) -> None:
-    """Render every PROGRAMS_DIR/*.asm (default: programs) to PNGs in OUT.
+    """Render every PROGRAMS_DIR/*.asm (default: programs) to PNGs in folder DIR.
 
     Each program's header sets its frame count (``; frames: N``) and mode. Files are
     named after the program, with the frame number for animations
@@ -92,7 +91,7 @@ def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnor
 
     \b
     Example:
-      rend3r render-all programs -o out/ --precision fp16
+      rend3r render-all programs -o out/renders --precision fp32
     """
     from ..emu import EmuOptions
 

@@ -1,4 +1,6 @@
-"""write_atomic: complete files or nothing, never a stray temporary."""
+"""write_atomic: complete files or nothing, never a stray temporary; missing parent
+folders made (and removed again when the write fails); impossible paths refused as
+``cannot write PATH: reason``."""
 
 import os
 import stat
@@ -6,7 +8,7 @@ import stat
 import pytest
 
 from rend3r.errors import Rend3rError
-from rend3r.fileio import write_atomic
+from rend3r.fileio import make_output_folder, write_atomic
 
 
 def test_writes_new_file_with_umask_mode(tmp_path):
@@ -35,9 +37,52 @@ def test_relative_path_in_current_directory(tmp_path, monkeypatch):
     assert (tmp_path / "plain.mem").read_bytes() == b"x"
 
 
-def test_missing_directory_is_a_clear_error(tmp_path):
-    with pytest.raises(Rend3rError, match="cannot write"):
-        write_atomic(tmp_path / "nope" / "out.mem", b"x")
+def test_missing_parent_folders_are_made(tmp_path):
+    write_atomic(tmp_path / "a" / "b" / "out.mem", b"x")
+    assert (tmp_path / "a" / "b" / "out.mem").read_bytes() == b"x"
+
+
+def test_a_parent_that_is_a_file_is_refused_by_name(tmp_path):
+    (tmp_path / "f").write_text("keep")
+    target = tmp_path / "f" / "sub" / "out.mem"
+    with pytest.raises(Rend3rError, match=f"^cannot write {target}: {tmp_path / 'f'} is not a folder$"):
+        write_atomic(target, b"x")
+    assert (tmp_path / "f").read_text() == "keep"
+
+
+def test_an_unwritable_folder_is_refused_by_name(tmp_path, monkeypatch):
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o500)
+    real_access = os.access  # root may write anywhere: answer as for an ordinary user
+    monkeypatch.setattr(os, "access", lambda p, mode: real_access(p, mode) and os.fspath(p) != os.fspath(locked))
+    with pytest.raises(Rend3rError, match="^cannot write .*: folder .*locked is not writable$"):
+        write_atomic(locked / "new" / "out.mem", b"x")
+    assert list(locked.iterdir()) == []
+
+
+def test_a_folder_that_refuses_files_leaves_no_folder_behind(tmp_path):
+    # /proc takes no new files or folders, even from root: the OS's reason is given.
+    with pytest.raises(Rend3rError, match="^cannot write /proc/rend3r-test/out.mem: cannot create folder "):
+        write_atomic("/proc/rend3r-test/out.mem", b"x")
+
+
+def test_made_folders_are_removed_when_the_write_fails(tmp_path, monkeypatch):
+    def boom(fd):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(os, "fsync", boom)
+    with pytest.raises(Rend3rError, match="^cannot write .*out.mem: No space left on device$"):
+        write_atomic(tmp_path / "a" / "b" / "out.mem", b"x")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_output_folder_is_made_or_refused(tmp_path):
+    assert make_output_folder(tmp_path / "a" / "b").is_dir()
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(Rend3rError, match="^cannot write .*file: it is a file, not a folder$"):
+        make_output_folder(tmp_path / "file")
+    with pytest.raises(Rend3rError, match="^cannot write .*file/sub: .*file is not a folder$"):
+        make_output_folder(tmp_path / "file" / "sub")
 
 
 def test_failure_during_rename_leaves_old_file_and_no_temporary(tmp_path):

@@ -39,10 +39,19 @@ def test_wrong_extension_for_each_output_kind(tmp_path):
     assert not (tmp_path / "f.png").exists()  # refused before rendering
 
 
-def test_plain_name_in_a_missing_folder_is_refused(tmp_path):
-    r = _run(_src(tmp_path), "-o", tmp_path / "nope" / "f.png", "--size", "8x6")
-    assert r.exit_code == 1 and "does not exist" in r.output
-    assert not (tmp_path / "nope").exists()
+def test_plain_name_in_a_missing_folder_creates_it(tmp_path):
+    r = _run(_src(tmp_path), "-o", tmp_path / "new" / "f.png", "--size", "8x6")
+    assert r.exit_code == 0, r.output
+    assert Image.open(tmp_path / "new" / "f.png").size == (8, 6)
+
+
+def test_output_under_a_file_is_refused_by_name_before_rendering(tmp_path):
+    (tmp_path / "plain").write_text("x")
+    target = tmp_path / "plain" / "sub" / "f.png"
+    r = _run(_src(tmp_path), "-o", tmp_path / "f.png", "--depth-image", target, "--size", "8x6")
+    assert r.exit_code == 1, r.output
+    assert r.output == f"rend3r: error: cannot write {target}: {tmp_path / 'plain'} is not a folder\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain", "s.asm"]
 
 
 def test_pattern_creates_its_folders(tmp_path):
@@ -75,10 +84,11 @@ def test_frames_zero_and_huge_sizes_are_usage_errors(tmp_path):
         assert r.exit_code == 2 and "--size" in r.output, (size, r.output)
 
 
-def test_trace_file_in_a_missing_folder_is_refused_before_rendering(tmp_path):
+def test_trace_file_under_a_file_is_refused_before_rendering(tmp_path):
+    (tmp_path / "plain").write_text("x")
     r = _run(_src(tmp_path), "-o", tmp_path / "f.png", "--size", "8x6", "--trace-pixel", "1,1",
-             "--trace", tmp_path / "nope" / "t.jsonl")
-    assert r.exit_code == 1 and "does not exist" in r.output
+             "--trace", tmp_path / "plain" / "t.jsonl")
+    assert r.exit_code == 1 and "is not a folder" in r.output
     assert not (tmp_path / "f.png").exists()
 
 
@@ -213,14 +223,14 @@ def test_outputs_commit_all_or_roll_back_every_one(tmp_path):
     (tmp_path / "old.png").write_bytes(b"old")
     out = Outputs()
     for name in ("old.png", "new.png", "sub/deep/x.png", "late.png"):
-        out.reserve(tmp_path / name, make_parents=True)
+        out.reserve(tmp_path / name)
     out.write(tmp_path / "old.png", b"new content")
     out.write(tmp_path / "new.png", b"n")
     out.write(tmp_path / "sub" / "deep" / "x.png", b"x")
     out.write(tmp_path / "late.png", b"l")
     assert (tmp_path / "old.png").read_bytes() == b"old" and not (tmp_path / "new.png").exists()
     (tmp_path / "late.png").mkdir()  # the last rename fails after the others were done
-    with pytest.raises(Rend3rError, match="late.png: cannot write"):
+    with pytest.raises(Rend3rError, match="cannot write .*late.png: "):
         out.commit()
     assert (tmp_path / "old.png").read_bytes() == b"old"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["late.png", "old.png"]  # sub/ removed, no stray file

@@ -81,3 +81,21 @@ def test_huge_size_is_a_usage_error(tmp_path: Path) -> None:
     r = CliRunner().invoke(main, ["render-all", str(tmp_path), "-o", str(tmp_path / "o"), "--size", "100000x100000"])
     assert r.exit_code == 2 and "1..8192" in r.output
     assert not (tmp_path / "o").exists()
+
+
+def test_output_folder_and_its_parents_are_made(tmp_path: Path) -> None:
+    shutil.copy(PROGRAMS_DIR / "sphere.asm", tmp_path / "sphere.asm")
+    out = tmp_path / "a" / "b"
+    r = CliRunner().invoke(main, ["render-all", str(tmp_path), "--output", str(out), "--size", "8x6"])
+    assert r.exit_code == 0, r.output
+    assert Image.open(out / "sphere.png").size == (8, 6)
+
+
+def test_output_under_a_file_is_a_clean_error(tmp_path: Path) -> None:
+    shutil.copy(PROGRAMS_DIR / "sphere.asm", tmp_path / "sphere.asm")
+    (tmp_path / "plain").write_text("x")
+    for out, why in ((tmp_path / "plain", "it is a file, not a folder"),
+                     (tmp_path / "plain" / "sub", f"{tmp_path / 'plain'} is not a folder")):
+        r = CliRunner().invoke(main, ["render-all", str(tmp_path), "-o", str(out), "--size", "8x6"])
+        assert (r.exit_code, r.output) == (1, f"rend3r: error: cannot write {out}: {why}\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain", "sphere.asm"]

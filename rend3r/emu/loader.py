@@ -1,4 +1,6 @@
-"""Loading a program: assembly source, or any memory-image format the assembler writes."""
+"""Loading a program: assembly source, or any memory-image format the assembler writes;
+the one loader of ``emulate``, ``send`` and ``render-all`` (what a file is comes from
+:mod:`rend3r.asm.formats.recognise`, shared with ``asm`` and ``disasm``)."""
 
 from __future__ import annotations
 
@@ -7,9 +9,8 @@ import stat
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..asm.formats.recognise import kind_by_name, refuse_foreign_file
 from ..errors import Rend3rError
-
-SOURCE_SUFFIXES = (".asm", ".s", ".r3", ".rend3r")
 
 
 @dataclass(frozen=True)
@@ -26,16 +27,19 @@ def load_program(path: str | os.PathLike[str]) -> LoadedProgram:
     A file whose suffix names a memory format (``.mem``, ``.bin``, ...) is only read as
     that format, so a malformed or oversized image is reported as such and never handed
     to the assembler; the size limits are the readers' (``rend3r.asm.formats.byte_limit``).
+    A picture or an archive is refused by name, whatever its suffix.
     """
     p = Path(path)
-    if p.suffix.lower() in SOURCE_SUFFIXES:
+    kind = kind_by_name(p)
+    refuse_foreign_file(p)
+    if kind == "source":
         return _assemble(p)
-    from ..asm.formats import IMAGE_EXTENSIONS, byte_limit, read_file
+    from ..asm.formats import byte_limit, read_file
 
     try:
         return LoadedProgram(list(read_file(p)), None)
     except Rend3rError as as_image:
-        if p.suffix.lower() in IMAGE_EXTENSIONS or not _small_regular_file(p, byte_limit(None)):
+        if kind == "image" or not _small_regular_file(p, byte_limit(None)):
             raise
         try:
             return _assemble(p)

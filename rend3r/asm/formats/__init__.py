@@ -23,6 +23,7 @@ from .common import BYTES_PER_WORD, MAX_WORDS, check_byteorder, is_text
 from .ihex import read_ihex, render_ihex
 from .listing import read_lst, render_lst
 from .mem import read_mem, render_mem, render_mem_annotated
+from .recognise import HEAD, IMAGE_SUFFIXES, refuse_foreign
 
 
 @dataclass(frozen=True)
@@ -56,11 +57,8 @@ _READERS: dict[str, Callable[[bytes, str, str], list[int]]] = {
     "lst": lambda data, name, order: read_lst(data, name),
 }
 
-#: Extensions that name one format. ``.hex`` is absent on purpose: it is used both for
-#: Intel HEX and for ``$readmemh`` files, so such files are told apart by content.
-_EXTENSIONS = {".mem": "mem", ".bin": "bin", ".coe": "coe", ".ihex": "ihex", ".ihx": "ihex", ".lst": "lst"}
-#: Suffixes that make a file a memory image (read as one only, never as source).
-IMAGE_EXTENSIONS = frozenset(_EXTENSIONS)
+#: Extensions that name one format (``rend3r.asm.formats.recognise``).
+_EXTENSIONS = IMAGE_SUFFIXES
 
 
 def _check_format(fmt: str) -> None:
@@ -126,13 +124,15 @@ def byte_limit(fmt: str | None) -> int:
 def read_words(data: bytes, fmt: str | None = None, name: str = "<input>", byteorder: str = "big") -> list[int]:
     """The words of a memory image in format ``fmt`` (detected from content when None).
 
-    ``byteorder`` applies to ``bin`` and ``ihex``. Malformed input, or more bytes than
-    :func:`byte_limit` allows the format, raises Rend3rError.
+    ``byteorder`` applies to ``bin`` and ``ihex``. Malformed input, more bytes than
+    :func:`byte_limit` allows the format, or (when the format is not given) a picture or
+    an archive (:func:`refuse_foreign`) raises Rend3rError.
     """
     check_byteorder(byteorder)
     if fmt is None:
         if not data:
             raise Rend3rError(f"{name}: empty file: no words")
+        refuse_foreign(bytes(data[:HEAD]), name)
         fmt = detect_format(data)
     _check_format(fmt)
     if len(data) > byte_limit(fmt):
@@ -142,7 +142,8 @@ def read_words(data: bytes, fmt: str | None = None, name: str = "<input>", byteo
 
 
 def read_file(path: str | os.PathLike[str], fmt: str | None = None, byteorder: str = "big") -> list[int]:
-    """Read a memory image file; the format is detected by extension, then by content.
+    """Read a memory image file; the format is detected by extension, then by content (a
+    picture or an archive is refused by name unless ``fmt`` is given).
 
     The file's size is checked before it is read (:func:`byte_limit` of the format its
     extension or ``fmt`` names, else of the largest), so a huge or endless file costs nothing.
@@ -155,6 +156,7 @@ def read_file(path: str | os.PathLike[str], fmt: str | None = None, byteorder: s
     if fmt is None:
         if not data:
             raise Rend3rError(f"{name}: empty file: no words")
+        refuse_foreign(data[:HEAD], name)
         fmt = detect_format(data, name)
     return read_words(data, fmt, name, byteorder)
 
@@ -169,4 +171,4 @@ def read_stream(stream: BinaryIO, fmt: str | None = None, name: str = "<stdin>",
     return read_words(data, fmt, name, byteorder)
 
 
-__all__ = ["FORMATS", "IMAGE_EXTENSIONS", "Format", "byte_limit", "detect_format", "read_file", "read_stream", "read_words", "render"]
+__all__ = ["FORMATS", "Format", "byte_limit", "detect_format", "read_file", "read_stream", "read_words", "render"]

@@ -25,21 +25,31 @@ def parse_size(text: str, max_side: int = MAX_SIDE) -> tuple[int, int]:
 
 
 class SizeType(click.ParamType):
-    """A click parameter type for ``WxH`` image sizes (bad values exit 2, as bad options do)."""
+    """A click parameter type for ``WxH`` image sizes, each side 1..``max_side`` (bad values
+    exit 2, as bad options do)."""
 
     name = "WxH"
+
+    def __init__(self, max_side: int = MAX_SIDE) -> None:
+        self.max_side = max_side
+
+    def get_metavar(self, param, ctx=None) -> str:  # click < 8.2 passes no ctx
+        return "WxH"
 
     def convert(self, value, param, ctx) -> tuple[int, int]:
         if isinstance(value, tuple):
             return value
         try:
-            return parse_size(str(value))
+            return parse_size(str(value), self.max_side)
         except ValueError as exc:
             self.fail(str(exc), param, ctx)
 
 
 #: The shared instance: ``@click.option("--size", type=SIZE, default="512x384")``.
 SIZE = SizeType()
+
+#: The device's frame size, the default ``--size`` of every command that renders.
+DEVICE_SIZE = "512x384"
 
 
 #: ``--jobs N``: threads rendering each frame (0, the default: every core this process may use).

@@ -13,7 +13,10 @@ from pathlib import Path
 
 import click
 
+from ..cli import INTERRUPTED
+from ..cliutil import DEVICE_SIZE, SizeType
 from ..errors import Rend3rError
+from .execute import MAX_DEVICE_SIDE
 from .links import (
     DEFAULT_ETHERTYPE, DEFAULT_MAC, ETH_MAX_PAYLOAD, EthernetLink, Link, SerialLink,
     ethernet_frame, format_mac, open_serial, parse_mac,
@@ -36,17 +39,20 @@ def _ethertype(text: str) -> int:
     return value
 
 
-def read_program(path: str):
-    """The program at ``path``: assembled when it is ``.asm``, else read as a memory image."""
-    from ..asm.program import Emitted, Program
+#: ``send -o FILE``: what each file suffix writes.
+OUTPUT_KINDS = {".mem": "mem", ".coe": "coe", ".pcap": "pcap"}
 
-    if Path(path).suffix.lower() == ".asm":
-        from ..asm.assembler import assemble_or_raise
 
-        return assemble_or_raise(path).program
-    from ..asm.formats import read_file
+def plural(n: int, noun: str) -> str:
+    """``"1 frame"``, ``"0 frames"``, ``"3 frames"``."""
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
-    return Program([Emitted(0, tuple(read_file(path)))])
+
+def _output_kind(path: str) -> str:
+    kind = OUTPUT_KINDS.get(Path(path).suffix.lower())
+    if kind is None:
+        raise Rend3rError(f"{path}: -o writes a .mem ($readmemh), .coe (Xilinx) or .pcap (Ethernet frames) file")
+    return kind
 
 
 class _Progress:
@@ -65,66 +71,75 @@ class _Progress:
 
 @click.command("send")
 @click.argument("program", type=click.Path(dir_okay=False))
-@click.option("--mem", "mem_out", metavar="FILE", help="Write a $readmemh main.mem (atomically).")
-@click.option("--coe", "coe_out", metavar="FILE", help="Write a Xilinx .coe file (atomically).")
+@click.option("-o", "--output", metavar="FILE",
+              help="Write the load to a file instead of a device: FILE.mem ($readmemh, the board's main.mem), "
+                   "FILE.coe (Xilinx) or FILE.pcap (its Ethernet frames).")
 @click.option("--eth", "iface", metavar="IFACE", help="Send raw Ethernet frames on this interface.")
-@click.option("--pcap", "pcap_out", metavar="FILE", help="Write the Ethernet frames to a pcap file instead.")
+@click.option("--mem", "mem_out", metavar="FILE", hidden=True)  # -o FILE.mem, as before -o existed
+@click.option("--coe", "coe_out", metavar="FILE", hidden=True)  # -o FILE.coe
+@click.option("--pcap", "pcap_out", metavar="FILE", hidden=True)  # -o FILE.pcap
 @click.option("--serial", "port", metavar="PORT", help="Serial device path or pyserial URL (loop://, socket://, rfc2217://).")
 @click.option("--mac", default=DEFAULT_MAC, show_default=True, help="Device MAC address.")
-@click.option("--ethertype", default=f"0x{DEFAULT_ETHERTYPE:04x}", show_default=True)
+@click.option("--ethertype", default=f"0x{DEFAULT_ETHERTYPE:04x}", show_default=True, metavar="TYPE")
 @click.option("--framing", type=click.Choice(["protocol", "raw"]), default="protocol", show_default=True,
               help="raw: bare big-endian words, no header, no acknowledgement (the original receiver).")
-@click.option("--baud", type=int, default=115200, show_default=True)
+@click.option("--baud", type=int, default=115200, show_default=True, metavar="RATE")
 @click.option("--timeout", type=float, default=DEFAULT_TIMEOUT, show_default=True,
               help="Seconds to wait for each acknowledgement.")
 @click.option("--retries", type=click.IntRange(0, 1000), default=DEFAULT_RETRIES, show_default=True,
               help="Resends per frame (and restarts per load) before giving up.")
 @click.option("--run", "run_after", is_flag=True, help="Send RUN after the program is committed.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress or summary output.")
-def send_command(program: str, mem_out: str | None, coe_out: str | None, iface: str | None,
+def send_command(program: str, output: str | None, iface: str | None, mem_out: str | None, coe_out: str | None,
                  pcap_out: str | None, port: str | None, mac: str, ethertype: str, framing: str,
                  baud: int, timeout: float, retries: int, run_after: bool, quiet: bool) -> None:
-    """Send PROGRAM (.asm source or any memory image) to a device or a file.
+    """Send PROGRAM (source or any memory image) to a device, or write it to a file.
 
     Over --eth and --serial the load is acknowledged frame by frame and committed with
     the program's CRC-32; the device keeps its previous program unless the commit matches.
+    A running device starts a committed program at once, as the board does; --run
+    starts a stopped one.
 
     \b
     Examples:
-      rend3r send programs/sphere.asm --mem main.mem
+      rend3r send programs/sphere.asm -o out/main.mem
       rend3r send programs/sphere.asm --serial /dev/ttyUSB0 --baud 3000000 --run
       rend3r send main.mem --eth enp3s0 --mac 69:69:5a:06:54:91
-      rend3r send programs/sphere.asm --pcap load.pcap
+      rend3r send programs/sphere.asm -o out/load.pcap
     """
-    targets = [(n, v) for n, v in (("--mem", mem_out), ("--coe", coe_out), ("--eth", iface),
+    targets = [(n, v) for n, v in (("-o", output), ("--mem", mem_out), ("--coe", coe_out), ("--eth", iface),
                                    ("--pcap", pcap_out), ("--serial", port)) if v]
     if len(targets) != 1:
-        raise Rend3rError("choose exactly one of --mem, --coe, --eth, --pcap, --serial"
+        raise Rend3rError("choose exactly one of -o FILE, --eth IFACE, --serial PORT"
                           + (f" (got {', '.join(n for n, _ in targets)})" if targets else ""))
+    kind = (_output_kind(output) if output else "mem" if mem_out else "coe" if coe_out
+            else "pcap" if pcap_out else None)
+    out = output or mem_out or coe_out or pcap_out
     if timeout <= 0:
         raise Rend3rError(f"--timeout must be positive, not {timeout:g}")
     if baud <= 0:
         raise Rend3rError(f"--baud must be positive, not {baud}")
     device_mac = parse_mac(mac)
     etype = _ethertype(ethertype)
-    if run_after and (mem_out or coe_out):
-        raise Rend3rError("--run needs a device (--eth, --serial or --pcap), not a file")
-    prog = read_program(program)
-    words = prog.words
+    if run_after and kind in ("mem", "coe"):
+        raise Rend3rError(f"--run needs a device (--eth, --serial) or a .pcap file, not a .{kind} file")
+    from ..emu.loader import load_program
+
+    words = load_program(program).words
     say = (lambda msg: None) if quiet else (lambda msg: click.echo(msg, err=True))
     crc = program_crc(words)
 
-    if mem_out or coe_out:
+    if kind in ("mem", "coe"):
         from ..asm.formats import render
+        from ..asm.program import Emitted, Program
         from ..fileio import write_atomic
 
-        fmt, out = ("mem", mem_out) if mem_out else ("coe", coe_out)
-        write_atomic(out, render(fmt, prog))
-        say(f"wrote {len(words)} words (CRC-32 {crc:08x}) to {out}")
+        write_atomic(out, render(kind, Program([Emitted(0, tuple(words))])))
+        say(f"wrote {plural(len(words), 'word')} (CRC-32 {crc:08x}) to {out}")
         return
-    if pcap_out:
-        _write_pcap(pcap_out, words, device_mac, etype, framing, run_after)
-        say(f"wrote {len(words)} words (CRC-32 {crc:08x}) as {framing} frames to {pcap_out}")
+    if kind == "pcap":
+        _write_pcap(out, words, device_mac, etype, framing, run_after)
+        say(f"wrote {plural(len(words), 'word')} (CRC-32 {crc:08x}) as {framing} frames to {out}")
         return
 
     link: Link = (EthernetLink(iface, peer=device_mac, ethertype=etype) if iface
@@ -137,7 +152,7 @@ def send_command(program: str, mem_out: str | None, coe_out: str | None, iface: 
         try:
             if framing == "raw":
                 _send_raw(link, words)
-                say(f"sent {len(words)} raw words to {where} (no acknowledgement in raw framing)")
+                say(f"sent {plural(len(words), 'raw word')} to {where} (no acknowledgement in raw framing)")
                 return
             sender = Sender(link, timeout=timeout, retries=retries,
                             progress=_Progress(not quiet and len(words) >= 4096))
@@ -152,9 +167,18 @@ def send_command(program: str, mem_out: str | None, coe_out: str | None, iface: 
         raise Rend3rError(f"the device reports {status.words} words with CRC-32 {status.crc:08x} "
                           f"after loading {len(words)} words with CRC-32 {crc:08x}")
     s = sender.stats
-    say(f"loaded {len(words)} words (CRC-32 {crc:08x}) on {where} in {elapsed * 1e3:.1f} ms; "
-        f"{s.frames} frames, {s.resends} resent; device: {'running' if status.running else 'stopped'}, "
-        f"{status.frames} frames rendered")
+    say(f"loaded {plural(len(words), 'word')} (CRC-32 {crc:08x}) on {where} in {elapsed * 1e3:.1f} ms "
+        f"({plural(s.frames, 'protocol frame')}, {s.resends} resent); {_device_state(status)}")
+
+
+def _device_state(status) -> str:
+    """What the device does with the program, as its STATUS reply tells (frames render in the
+    background, so a count taken at the commit is usually 0 and is not shown then)."""
+    if not status.running:
+        return "the device is stopped (--run starts it)"
+    if status.frames == 0:
+        return "the device is running it"
+    return f"the device is running it ({plural(status.frames, 'frame')} rendered since its last reset)"
 
 
 def _raw_payloads(words: list[int]) -> list[bytes]:
@@ -220,8 +244,8 @@ def serve(link: Link, core, stop: threading.Event, poll: float = 0.1) -> None:
 @click.command("device")
 @click.option("--eth", "iface", metavar="IFACE", help="Listen for raw Ethernet frames on this interface.")
 @click.option("--serial", "port", metavar="PORT", help="Serial device path or pyserial URL.")
-@click.option("-o", "--output", "out_dir", required=True, type=click.Path(file_okay=False),
-              help="Directory for the rendered frames (PNG).")
+@click.option("-o", "--output", "out_dir", required=True, metavar="DIR",
+              help="Folder for the rendered frames, runNNNN_frameFFFF.png (made if missing).")
 @click.option("--mac", default=DEFAULT_MAC, show_default=True, help="The MAC address the device answers to.")
 @click.option("--ethertype", default=f"0x{DEFAULT_ETHERTYPE:04x}", show_default=True)
 @click.option("--baud", type=int, default=115200, show_default=True)
@@ -231,32 +255,32 @@ def serve(link: Link, core, stop: threading.Event, poll: float = 0.1) -> None:
               show_default=True, help="Most frames rendered per second.")
 @click.option("--frames", "max_frames", type=click.IntRange(1), default=8, show_default=True,
               help="Frames rendered per program run (bounds looping programs).")
-@click.option("--size", default="128x96", show_default=True, help="Rendered frame size WxH.")
+@click.option("--size", type=SizeType(MAX_DEVICE_SIDE), default=DEVICE_SIZE, show_default=True,
+              help=f"Rendered frame size (1..{MAX_DEVICE_SIDE} each); the board's is {DEVICE_SIZE}.")
 def device_command(iface: str | None, port: str | None, out_dir: str, mac: str, ethertype: str,
-                   baud: int, max_words: int, max_frame_rate: float, max_frames: int, size: str) -> None:
+                   baud: int, max_words: int, max_frame_rate: float, max_frames: int, size: tuple[int, int]) -> None:
     """A virtual REND3R device: receive programs, run them, write each frame to DIR.
 
     It applies the load protocol (docs/protocol.md), swaps in a program only when its
-    commit matches, renders it with the emulator and answers status. Ctrl-C stops it.
+    commit matches, renders it with the emulator and answers status. Each program run
+    is numbered from 1 (run0001_...) and its frames from 0 (..._frame0000.png), as
+    emulate numbers them. Ctrl-C stops it (exit status 130; SIGTERM: 0).
 
     \b
     Examples:
-      rend3r device --serial /dev/pts/5 -o frames/
-      rend3r device --eth veth1 -o frames/ --size 512x384
+      rend3r device --serial /dev/pts/5 -o out/frames
+      rend3r device --eth veth1 -o out/frames --size 128x96
     """
+    from ..fileio import make_output_folder
     from .device import DeviceCore
-    from .execute import RenderExecutor, parse_size
+    from .execute import RenderExecutor
 
     if bool(iface) == bool(port):
         raise Rend3rError("choose exactly one of --eth and --serial")
     device_mac = parse_mac(mac)
     etype = _ethertype(ethertype)
-    width, height = parse_size(size)
-    out = Path(out_dir)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise Rend3rError(f"{out}: cannot create the output directory: {exc.strerror or exc}") from None
+    width, height = size
+    out = make_output_folder(out_dir)
     link: Link = (EthernetLink(iface, ethertype=etype, device_mac=device_mac) if iface
                   else SerialLink(open_serial(port, baud)))
     logging.basicConfig(stream=sys.stderr, level=logging.INFO, format="rend3r device: %(message)s")
@@ -264,8 +288,14 @@ def device_command(iface: str | None, port: str | None, out_dir: str, mac: str, 
                               max_frame_rate=max_frame_rate)
     core = DeviceCore(executor, max_words=max_words)
     stop = threading.Event()
+    received: list[int] = []
+
+    def on_signal(signum: int, _frame) -> None:
+        received.append(signum)
+        stop.set()
+
     for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: stop.set())
+        signal.signal(sig, on_signal)
     where = f"{iface} as {format_mac(device_mac)}" if iface else port
     click.echo(f"rend3r device: listening on {where}, frames to {out}", err=True)
     with link:
@@ -274,7 +304,10 @@ def device_command(iface: str | None, port: str | None, out_dir: str, mac: str, 
         finally:
             executor.close()
     c = core.counters
-    foreign = f", {link.foreign} frames for other addresses" if isinstance(link, EthernetLink) else ""
+    foreign = (f", {plural(link.foreign, 'frame')} for other addresses" if isinstance(link, EthernetLink) else "")
     nacks = ", ".join(f"{k.name} {v}" for k, v in sorted(c.nacks.items())) or "none"
-    click.echo(f"rend3r device: stopped after {c.loads} loads, {executor.frames} frames rendered, "
-               f"{c.malformed} malformed frames{foreign}; NACKs: {nacks}", err=True)
+    click.echo(f"rend3r device: stopped after {plural(c.loads, 'load')} ({plural(executor.runs, 'run')}), "
+               f"{plural(executor.frames, 'frame')} rendered, {plural(c.malformed, 'malformed protocol frame')}"
+               f"{foreign}; NACKs: {nacks}", err=True)
+    if signal.SIGINT in received:  # Ctrl-C: the status every command gives when interrupted
+        click.get_current_context().exit(INTERRUPTED)

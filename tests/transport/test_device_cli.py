@@ -53,13 +53,14 @@ def test_source_to_png_over_a_pty(pty_bridge, tmp_path):
         r = subprocess.run(RENDER + ["send", str(PROGRAMS / "sphere.asm"), "--serial",
                                      pty_bridge.paths[0]], capture_output=True, text=True, timeout=60)
         assert r.returncode == 0, r.stderr
+        assert "loaded 23 words" in r.stderr and "; the device is running it" in r.stderr, r.stderr
         assert wait_for(lambda: any(out.glob("*.png")))
     finally:
         err = stop_device(device)
-    png = sorted(out.glob("*.png"))[0]
-    with Image.open(png) as im:
+    assert sorted(p.name for p in out.glob("*.png")) == ["run0001_frame0000.png"]  # sphere.asm ends after one
+    with Image.open(out / "run0001_frame0000.png") as im:
         assert im.size == (32, 24)
-    assert "stopped after 1 loads" in err and "1 malformed frames" in err
+    assert "stopped after 1 load (1 run), 1 frame rendered, 1 malformed protocol frame;" in err, err
 
 
 def test_device_refuses_bad_arguments(tmp_path):
@@ -68,20 +69,37 @@ def test_device_refuses_bad_arguments(tmp_path):
         (["--serial", str(tmp_path / "none")], "cannot open serial port"),
         (["--eth", "nosuch0"], "no such network interface: nosuch0"),
         (["--serial", "loop://", "--mac", "01:02"], "malformed MAC address"),
-        (["--serial", "loop://", "--size", "0x5"], "malformed size"),
     ]:
         r = subprocess.run(RENDER + ["device", "-o", str(tmp_path / "o"), *args],
                            capture_output=True, text=True, timeout=60)
         assert r.returncode == 1 and message in r.stderr, (args, r.stderr)
         assert "Traceback" not in r.stderr
+    for size in ("0x5", "4097x1", "128"):
+        r = subprocess.run(RENDER + ["device", "--serial", "loop://", "-o", str(tmp_path / "o"), "--size", size],
+                           capture_output=True, text=True, timeout=60)
+        assert r.returncode == 2 and "Invalid value for '--size'" in r.stderr, (size, r.stderr)
+    (tmp_path / "plain").write_text("x")
+    r = subprocess.run(RENDER + ["device", "--serial", "loop://", "-o", str(tmp_path / "plain" / "frames")],
+                       capture_output=True, text=True, timeout=60)
+    assert (r.returncode, r.stderr) == (1, f"rend3r: error: cannot write {tmp_path / 'plain' / 'frames'}: "
+                                           f"{tmp_path / 'plain'} is not a folder\n")
+
+
+def test_device_renders_at_the_boards_size_by_default():
+    from click.testing import CliRunner
+
+    from rend3r.cli import main
+
+    r = CliRunner().invoke(main, ["device", "--help"])
+    assert "--size WxH" in r.output and "[default: 512x384]" in r.output
 
 
 @pytest.mark.timeout(60)
-def test_device_stops_on_sigint(tmp_path):
-    device = start_device(["--serial", "loop://", "-o", str(tmp_path / "o")])
+def test_device_stops_on_sigint_with_the_interrupted_status(tmp_path):
+    device = start_device(["--serial", "loop://", "-o", str(tmp_path / "a" / "o")])
     device.send_signal(signal.SIGINT)
     _, err = device.communicate(timeout=30)
-    assert device.returncode == 0 and "stopped after 0 loads" in err
+    assert device.returncode == 130 and "stopped after 0 loads (0 runs), 0 frames rendered" in err, err
 
 
 @pytest.mark.timeout(120)

@@ -26,10 +26,12 @@ def send(*args: str) -> subprocess.CompletedProcess:
 
 
 @pytest.mark.parametrize("fmt", ["mem", "coe"])
-def test_file_targets_match_the_formats_module(tmp_path, fmt):
+@pytest.mark.parametrize("option", ["-o", "--output", "alias"])
+def test_file_targets_match_the_formats_module(tmp_path, fmt, option):
     out = tmp_path / f"main.{fmt}"
-    r = send(PROGRAMS / "sphere.asm", f"--{fmt}", out)
+    r = send(PROGRAMS / "sphere.asm", f"--{fmt}" if option == "alias" else option, out)
     assert r.returncode == 0, r.stderr
+    assert r.stderr.startswith("wrote 23 words (CRC-32 ")
     program = assemble_or_raise(PROGRAMS / "sphere.asm").program
     assert out.read_bytes() == render(fmt, program)
     assert read_file(out) == program.words
@@ -39,16 +41,37 @@ def test_file_targets_match_the_formats_module(tmp_path, fmt):
 def test_memory_image_input_is_passed_through(tmp_path):
     src, out = tmp_path / "in.mem", tmp_path / "out.mem"
     src.write_text("00000200\n3c000009\n00000400\n00000000\n00000000\n")
-    assert send(src, "--mem", out).returncode == 0
+    assert send(src, "-o", out).returncode == 0
     assert out.read_text() == src.read_text()
 
 
+def test_output_folders_are_made_and_an_unknown_suffix_is_refused(tmp_path):
+    out = tmp_path / "a" / "b" / "load.pcap"
+    r = send(PROGRAMS / "sphere.asm", "-o", out)
+    assert r.returncode == 0 and out.stat().st_size > 0, r.stderr
+    r = send(PROGRAMS / "sphere.asm", "-o", tmp_path / "main.txt")
+    assert r.returncode == 1 and "-o writes a .mem ($readmemh), .coe (Xilinx) or .pcap" in r.stderr
+    (tmp_path / "plain").write_text("x")
+    r = send(PROGRAMS / "sphere.asm", "-o", tmp_path / "plain" / "main.mem")
+    assert (r.returncode, r.stderr) == (1, f"rend3r: error: cannot write {tmp_path / 'plain' / 'main.mem'}: "
+                                           f"{tmp_path / 'plain'} is not a folder\n")
+
+
+@pytest.mark.parametrize("name", ["scene.rdr", "scene.s", "scene.asm"])
+def test_source_is_recognised_by_every_source_suffix(tmp_path, name):
+    src, out = tmp_path / name, tmp_path / "out.mem"
+    src.write_text((PROGRAMS / "sphere.asm").read_text())
+    r = send(src, "-o", out)
+    assert r.returncode == 0, r.stderr
+    assert read_file(out) == assemble_or_raise(PROGRAMS / "sphere.asm").program.words
+
+
 @pytest.mark.parametrize("args, message", [
-    ([], "choose exactly one of --mem, --coe, --eth, --pcap, --serial"),
-    (["--mem", "a.mem", "--serial", "loop://"], "(got --mem, --serial)"),
-    (["--mem", "a.mem", "--run"], "--run needs a device"),
+    ([], "choose exactly one of -o FILE, --eth IFACE, --serial PORT"),
+    (["-o", "a.mem", "--serial", "loop://"], "(got -o, --serial)"),
+    (["-o", "a.mem", "--run"], "--run needs a device (--eth, --serial) or a .pcap file, not a .mem file"),
     (["--serial", "loop://", "--timeout", "0"], "--timeout must be positive"),
-    (["--pcap", "o.pcap", "--ethertype", "0x10"], "not an Ethernet II type"),
+    (["-o", "o.pcap", "--ethertype", "0x10"], "not an Ethernet II type"),
     (["--pcap", "o.pcap", "--ethertype", "zz"], "malformed EtherType"),
 ])
 def test_bad_arguments(tmp_path, args, message):
@@ -61,10 +84,10 @@ def test_bad_arguments(tmp_path, args, message):
 def test_source_errors_are_reported_without_output(tmp_path):
     bad = tmp_path / "bad.asm"
     bad.write_text("frobnicate 1, 2\n")
-    r = send(bad, "--mem", tmp_path / "o.mem")
+    r = send(bad, "-o", tmp_path / "o.mem")
     assert r.returncode == 1 and "bad.asm:1" in r.stderr and "Traceback" not in r.stderr
     assert not (tmp_path / "o.mem").exists()
-    r = send(tmp_path / "missing.mem", "--mem", tmp_path / "o.mem")
+    r = send(tmp_path / "missing.mem", "-o", tmp_path / "o.mem")
     assert r.returncode == 1 and "missing.mem" in r.stderr
 
 

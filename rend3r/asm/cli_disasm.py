@@ -11,6 +11,7 @@ from ..errors import Rend3rError
 from ..fileio import write_atomic
 from .disasm import ISA_EXTENSIONS, MODES, disassemble
 from .formats import FORMATS, read_file, read_stream
+from .formats.recognise import refuse_wrong_kind
 
 
 @click.command(
@@ -24,7 +25,8 @@ Examples:
   cat main.mem | rend3r disasm -               # read standard input""",
 )
 @click.argument("src", metavar="IN")
-@click.option("-o", "--output", "out", metavar="OUT", help="Write the source here (atomically) instead of to stdout.")
+@click.option("-o", "--output", "out", metavar="FILE",
+              help="Write the source here (atomically; missing folders are made) instead of to stdout.")
 @click.option(
     "--mode",
     type=click.Choice(list(MODES)),
@@ -69,6 +71,8 @@ def disasm_command(src: str, out: str | None, mode: str, fmt: str | None, byteor
     if src == "-":
         words = read_stream(sys.stdin.buffer, fmt, "<stdin>", byteorder)
     else:
+        if fmt is None:
+            refuse_wrong_kind(src, "image")
         words = read_file(src, fmt, byteorder)
     text = disassemble(words, mode, addresses, isa_ext)
     if out is None:

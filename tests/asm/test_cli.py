@@ -85,7 +85,7 @@ def test_warnings_and_werror(tmp_path: Path):
     r = run(str(w))
     assert r.exit_code == 0 and "warning: 0x3c00 is the integer 15360" in r.stderr
     assert r.stdout_bytes == b"73800801\n00000000\n00000000\n"
-    for flag in (["-W", "error"], ["--werror"]):
+    for flag in (["-W", "error"], ["--werror"]):  # --werror: the old spelling, hidden
         r = run(str(w), *flag, "-o", str(tmp_path / "w.mem"))
         assert r.exit_code == 1 and "error: 0x3c00" in r.stderr
         assert not (tmp_path / "w.mem").exists()
@@ -134,3 +134,45 @@ def test_real_process(src: Path, tmp_path: Path):
     (tmp_path / "bad.asm").write_bytes(b"\xff\xfe\x00garbage")
     p = _rend3r("asm", "bad.asm", cwd=tmp_path)
     assert p.returncode == 1 and b"Traceback" not in p.stderr and b"is not UTF-8 text" in p.stderr
+
+
+def test_one_spelling_of_warnings_as_errors_is_documented():
+    r = run("--help")
+    assert "-W [error]" in r.stdout and "--werror" not in r.stdout
+
+
+def test_isa_ext_is_a_choice(src: Path):
+    r = CliRunner().invoke(main, ["asm", str(src), "--isa-ext", "hybrd"])
+    assert r.exit_code == 2 and "'hybrd' is not 'hybrid'" in r.output, r.output
+    assert run(str(src), "--isa-ext", "HYBRID").exit_code == 0
+
+
+@pytest.mark.parametrize("name", ["scene.rdr", "scene.s"])
+def test_every_source_suffix_assembles(tmp_path: Path, name: str):
+    (tmp_path / name).write_text(PROGRAM)
+    r = run(str(tmp_path / name))
+    assert r.exit_code == 0 and r.stdout_bytes == MEM
+
+
+@pytest.mark.parametrize("name, data, what", [
+    ("x.png", b"\x89PNG\r\n\x1a\n" + bytes(20), "a PNG image"),
+    ("x.jpg", b"\xff\xd8\xff\xe0" + bytes(20), "a JPEG image"),
+    ("x.asm", b"GIF89a" + bytes(20), "a GIF image"),
+    ("x.zip", b"PK\x03\x04" + bytes(20), "a ZIP archive"),
+    ("x.mem", b"00000200\n", "a memory image, not assembly source"),
+])
+def test_what_is_not_source_is_refused_by_name(tmp_path: Path, name: str, data: bytes, what: str):
+    (tmp_path / name).write_bytes(data)
+    r = CliRunner().invoke(main, ["asm", str(tmp_path / name), "-o", str(tmp_path / "o.mem")])
+    assert r.exit_code == 1 and r.output.startswith(f"rend3r: error: {tmp_path / name} is {what}"), r.output
+    assert not (tmp_path / "o.mem").exists()
+
+
+def test_outputs_make_their_folders_and_are_all_or_nothing(src: Path, tmp_path: Path):
+    r = run(str(src), "-f", "mem", "-f", "lst", "-o", str(tmp_path / "build" / "deep" / "scene"))
+    assert r.exit_code == 0
+    assert sorted(p.name for p in (tmp_path / "build" / "deep").iterdir()) == ["scene.lst", "scene.mem"]
+    (tmp_path / "taken.lst").mkdir()  # the second output cannot be written: the first is not either
+    r = CliRunner().invoke(main, ["asm", str(src), "-f", "mem", "-f", "lst", "-o", str(tmp_path / "taken")])
+    assert r.exit_code == 1 and r.output == f"rend3r: error: cannot write {tmp_path / 'taken.lst'}: it is a folder\n"
+    assert not (tmp_path / "taken.mem").exists()

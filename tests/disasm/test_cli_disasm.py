@@ -109,3 +109,33 @@ def test_real_process_exit_status_and_stderr(tmp_path):
     assert proc.returncode == 1
     assert proc.stdout == ""
     assert proc.stderr == f"rend3r: error: {bad}:2:32: empty value before ','\n"
+
+
+@pytest.mark.parametrize("name, data, what", [
+    ("x.png", b"\x89PNG\r\n\x1a\n" + bytes(20), "a PNG image"),
+    ("x.bin", b"\xff\xd8\xff\xe0" + bytes(20), "a JPEG image"),
+    ("x.gif", b"GIF87a" + bytes(22), "a GIF image"),
+    ("x.mem", b"PK\x05\x06" + bytes(20), "a ZIP archive"),
+    ("x.rdr", b"nr\ner\n", "assembly source, not a memory image"),
+    ("x.asm", b"nr\ner\n", "assembly source, not a memory image"),
+])
+def test_what_is_not_a_memory_image_is_refused_by_name(tmp_path, name, data, what):
+    (tmp_path / name).write_bytes(data)
+    r = run(str(tmp_path / name))
+    assert r.exit_code == 1 and r.output == f"rend3r: error: {tmp_path / name} is {what}" + (
+        " (rend3r asm assembles it)\n" if "source" in what else ", not a REND3R program (source or memory image)\n")
+
+
+def test_a_picture_on_standard_input_is_refused_and_a_given_format_reads_anything(tmp_path):
+    png = b"\x89PNG\r\n\x1a\n" + bytes(8)
+    r = run("-", stdin=png)
+    assert r.exit_code == 1 and "<stdin> is a PNG image" in r.output
+    r = run("-", "--format", "bin", stdin=png)
+    assert r.exit_code == 0 and ".word 0x89504e47" in r.output, r.output
+
+
+def test_output_folders_are_made(tmp_path):
+    (tmp_path / "in.mem").write_text("00000200\n00000000\n00000000\n")
+    r = run(str(tmp_path / "in.mem"), "-o", str(tmp_path / "a" / "b" / "out.asm"))
+    assert r.exit_code == 0, r.output
+    assert "\nnr\n" in (tmp_path / "a" / "b" / "out.asm").read_text()

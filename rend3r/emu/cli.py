@@ -5,6 +5,8 @@ from __future__ import annotations
 import io
 import sys
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import click
 
@@ -117,7 +119,8 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
             raise Rend3rError(f"--trace-pixel {x},{y} is outside the {options.width}x{options.height} frame")
     if pixels and options.mode == "hybrid":
         raise Rend3rError("--trace-pixel traces raytrace or raster mode; hybrid frames have no trace (docs/trace.md)")
-    count = execute(loaded.words, options, frames).frames
+    with _naming(program):
+        count = execute(loaded.words, options, frames).frames
     if count == 0:
         raise Rend3rError(f"{program}: the program renders no frame (no nf is executed)")
     for opt, path in (("-o", output), ("--depth-image", depth_path), ("--provenance", prov_path)):
@@ -190,6 +193,20 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
                    f"that cannot change a pixel, overflowing ones included); see --stats", err=True)
     if show_stats:
         click.echo(result.stats.report())
+
+
+@contextmanager
+def _naming(program: str) -> Iterator[None]:
+    """Put the program's file name in front of an error the processor reports (it knows
+    addresses, not files), so every error names the file it is about. The processor's
+    control-flow errors all come from :func:`execute`, before any rendering."""
+    try:
+        yield
+    except Rend3rError as exc:
+        message = str(exc)
+        if exc.preformatted or message.startswith(f"{program}:"):
+            raise
+        raise Rend3rError(f"{program}: {message}", exc.exit_code) from None
 
 
 #: emulate's options that a device quirk can set: click parameter -> (EmuOptions field, option name).

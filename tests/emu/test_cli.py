@@ -1,5 +1,7 @@
 """rend3r emulate end to end: real files in, real images out (CliRunner)."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from click.testing import CliRunner
@@ -100,12 +102,39 @@ def test_argument_errors(tmp_path, src, args, message):
     assert r.exit_code != 0 and message in r.output
 
 
-def test_errors_in_the_program_name_the_address(tmp_path):
+def test_errors_in_the_program_name_the_file_and_the_address(tmp_path):
     mem = tmp_path / "p.mem"
     mem.write_text("00000200\n00000006\n")
     r = _run(mem, "-o", tmp_path / "f.png")
-    assert r.exit_code == 1 and "address 1 (0x0001): unknown opcode" in r.output
+    assert r.exit_code == 1 and f"rend3r: error: {mem}: address 1 (0x0001): unknown opcode" in r.output
     assert not (tmp_path / "f.png").exists()
+
+
+def test_a_looping_program_without_frames_names_its_file(tmp_path):
+    animation = Path(__file__).resolve().parents[2] / "programs" / "animation.asm"
+    r = _run(animation, "-o", tmp_path / "f.png")
+    assert r.exit_code == 1 and r.output.startswith(
+        f"rend3r: error: {animation}: address 52 (0x0034): the program loops (lr); pass --frames N"), r.output
+
+
+@pytest.mark.parametrize("name", ["s.rdr", "s.s", "s.r3"])
+def test_source_is_recognised_by_every_source_suffix(tmp_path, name):
+    (tmp_path / name).write_text(SRC)
+    r = _run(tmp_path / name, "-o", tmp_path / "f.png", "--size", "8x6")
+    assert r.exit_code == 0, r.output
+
+
+@pytest.mark.parametrize("name, data, what", [
+    ("x.png", b"\x89PNG\r\n\x1a\n" + bytes(20), "a PNG image"),
+    ("x.mem", b"\xff\xd8\xff\xdb" + bytes(20), "a JPEG image"),
+    ("x", b"GIF89a" + bytes(20), "a GIF image"),
+    ("x.asm", b"PK\x03\x04" + bytes(20), "a ZIP archive"),
+])
+def test_pictures_and_archives_are_refused_by_name(tmp_path, name, data, what):
+    (tmp_path / name).write_bytes(data)
+    r = _run(tmp_path / name, "-o", tmp_path / "f.png", "--size", "8x6")
+    assert r.exit_code == 1 and r.output == (f"rend3r: error: {tmp_path / name} is {what}, "
+                                             "not a REND3R program (source or memory image)\n")
 
 
 def test_program_without_nf(tmp_path):

@@ -43,12 +43,13 @@ def load_image(path: Path, size: tuple[int, int] | None = None) -> np.ndarray:
 
 
 def save_rgb888_png(rgb: np.ndarray, path: Path) -> None:
-    """Write an (H, W, 3) uint8 image as PNG, atomically; its folder must exist."""
+    """Write an (H, W, 3) uint8 image as PNG, atomically (missing folders are made)."""
     from PIL import Image
 
     from ..emu.image import write_image
+    from ..fileio import write_atomic
 
-    write_image(path, Image.fromarray(np.ascontiguousarray(rgb), mode="RGB"))
+    write_image(path, Image.fromarray(np.ascontiguousarray(rgb), mode="RGB"), sink=write_atomic)
 
 
 def compare_files(
@@ -57,8 +58,10 @@ def compare_files(
     """Metrics of ``b`` against reference ``a``; writes the diff picture when asked."""
     if diff is not None:
         from ..emu.image import check_output
+        from ..fileio import check_writable
 
-        check_output(diff, (".png",))
+        check_output(diff, (".png",), make_parents=True)
+        check_writable(diff)
     x = as_rgb888(load_image(a, size))
     y = as_rgb888(load_image(b, size))
     if x.shape != y.shape:
@@ -77,10 +80,11 @@ def _psnr(ctx: click.Context, param: click.Parameter, value: float | None) -> fl
 @click.command("compare")
 @click.argument("a", type=click.Path(path_type=Path, dir_okay=False))
 @click.argument("b", type=click.Path(path_type=Path, dir_okay=False))
-@click.option("--diff", "diff_path", type=click.Path(path_type=Path, dir_okay=False), help="Write a diff PNG (changed pixels magenta).")
-@click.option("--max-channel", type=click.IntRange(0, 255), default=0, show_default=True, help="Largest allowed channel difference (RGB888).")
-@click.option("--max-share", type=click.FloatRange(0.0, 1.0), default=None, help="Largest allowed share of differing pixels (0..1).")
-@click.option("--min-psnr", type=float, default=None, callback=_psnr, help="Smallest allowed PSNR in dB (inf: identical).")
+@click.option("--diff", "diff_path", type=click.Path(path_type=Path), metavar="FILE",
+              help="Write a diff PNG (changed pixels magenta); missing folders are made.")
+@click.option("--max-channel", type=click.IntRange(0, 255), default=0, show_default=True, metavar="N", help="Largest allowed channel difference (RGB888).")
+@click.option("--max-share", type=click.FloatRange(0.0, 1.0), default=None, metavar="SHARE", help="Largest allowed share of differing pixels (0..1).")
+@click.option("--min-psnr", type=float, default=None, callback=_psnr, metavar="DB", help="Smallest allowed PSNR in dB (inf: identical).")
 @click.option("--size", type=SIZE, default=None, help="Size of raw RGB565 inputs (default 512x384).")
 def compare_command(
     a: Path, b: Path, diff_path: Path | None, max_channel: int, max_share: float | None, min_psnr: float | None,

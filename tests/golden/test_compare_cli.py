@@ -97,10 +97,20 @@ def test_min_psnr_nan_is_rejected(tmp_path: Path) -> None:
 
 def test_diff_path_is_checked_before_comparing(tmp_path: Path) -> None:
     a = _png(tmp_path / "a.png", np.zeros((2, 2, 3), np.uint8))
-    for diff, why in ((tmp_path / "sub" / "d.png", "does not exist"), (tmp_path / "d.txt", "unknown image type")):
-        r = CliRunner().invoke(main, ["compare", str(a), str(a), "--diff", str(diff)])
+    (tmp_path / "plain").write_text("x")
+    for diff, why in ((tmp_path / "plain" / "d.png", f"cannot write {tmp_path / 'plain' / 'd.png'}: "
+                                                     f"{tmp_path / 'plain'} is not a folder"),
+                      (tmp_path / "d.txt", "unknown image type")):
+        r = CliRunner().invoke(main, ["compare", str(a), str(a), "--diff", str(diff), "--size", "1x1"])
         assert r.exit_code == 2 and why in r.output, r.output
         assert not diff.exists()
+
+
+def test_diff_folders_are_made(tmp_path: Path) -> None:
+    a = _png(tmp_path / "a.png", np.zeros((2, 2, 3), np.uint8))
+    r = CliRunner().invoke(main, ["compare", str(a), str(a), "--diff", str(tmp_path / "x" / "y" / "d.png")])
+    assert r.exit_code == 0, r.output
+    assert Image.open(tmp_path / "x" / "y" / "d.png").size == (2, 2)
 
 
 @pytest.mark.parametrize(("pos", "value"), [(11, 0), (36, 0), (20, 0xFF)])

@@ -79,17 +79,20 @@ def trace_raytrace(scene: Scene, options: EmuOptions, frame: int, pixels: Iterab
             idx = int(fr.index[slot])
             for stage, value in zip(_SHAPE_STAGES, values):
                 w.put(stage, int(value) if stage == "hit" else value, idx, integer=stage == "hit")
-        shown = int(fr.index[t.nearest]) if t.nearest >= 0 else None
+        winner = int(fr.index[t.nearest]) if t.nearest >= 0 else None
+        # A winner whose hit point or lighting is not finite is a miss in the frame
+        # (background, provenance -1): nearest says so too; its light stages show why.
+        shown = None if t.colour is None else winner
         w.put("nearest", -1 if shown is None else shown, shown, integer=True)
-        if shown is not None:
+        if winner is not None:
             for light, values in zip(fr.lights, t.lights):
                 tag = f"L{light.index}."
                 for stage, value in zip(_LIGHT_STAGES, values):
-                    w.put(tag + stage, value, shown)
+                    w.put(tag + stage, value, winner)
                 if options.intensity_fixed:
-                    w.put(tag + "fixed", int(values[_FIXED]), shown, integer=True)
+                    w.put(tag + "fixed", int(values[_FIXED]), winner, integer=True)
                 if values[_LIT]:
-                    w.put(tag + "shadow", int(values[_SHADOW]), shown, integer=True)
+                    w.put(tag + "shadow", int(values[_SHADOW]), winner, integer=True)
         w.put("colour", options.background if t.colour is None else t.colour, shown, integer=True)
 
 

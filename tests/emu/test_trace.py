@@ -98,3 +98,24 @@ def test_parse_pixel_takes_bounded_decimal_pairs_only():
         with pytest.raises(ValueError, match="expected X,Y") as info:
             parse_pixel(bad)
         assert len(str(info.value)) < 100
+
+
+def test_nearest_is_minus_one_where_lighting_is_not_finite_as_in_the_frame():
+    # Radius 200 under ftz: the normal's components (about 1/200) square to subnormals,
+    # n.n flushes to 0 and I = n.l / 0 is infinite, so the frame draws the background.
+    big = (Prog().nr().cam(nclip=100.0, hfov=0.3, vfov=0.3)
+           .sphere(0, loc=(0.0, 0.0, -320.0), scale=(0.005, 0.005, 0.005), col=0xF800)
+           .dir_light(0, forward=(0.0, 0.0, -1.0)).nf().er())
+    opts = EmuOptions(width=16, height=12)
+    pixel = (8, 6)
+    scene, recs = _records(big.words, opts, [pixel])
+    frame, _ = render_frame(scene, opts)
+    assert _stage(recs, pixel, "hit")["dec"] == 1 and _stage(recs, pixel, "L0.n_len")["dec"] == 0
+    assert _stage(recs, pixel, "L0.cos")["dec"] == "inf"
+    assert frame.provenance[pixel[1], pixel[0]] == -1
+    nearest = _stage(recs, pixel, "nearest")
+    assert nearest["dec"] == -1 and nearest["shape"] is None
+    assert _stage(recs, pixel, "L0.cos")["shape"] == 0  # the light stages still show why
+    assert _stage(recs, pixel, "colour")["dec"] == int(frame.rgb565[pixel[1], pixel[0]]) == 0
+    ieee, _ = render_frame(scene, EmuOptions(width=16, height=12, subnormals="ieee"))
+    assert ieee.provenance[pixel[1], pixel[0]] == 0  # with gradual underflow the sphere is lit

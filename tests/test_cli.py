@@ -15,6 +15,26 @@ def test_every_registered_command_loads_and_has_an_example():
         assert "Example" in result.output or "example" in result.output, name
 
 
+#: The commands that write files, and what their -o/--output names.
+WRITERS = {"asm": "FILE|STEM", "disasm": "FILE", "emulate": "PATTERN", "send": "FILE", "device": "DIR",
+           "render-all": "DIR"}
+
+
+def test_every_command_that_writes_takes_dash_o_with_a_metavar_saying_what():
+    for name, metavar in WRITERS.items():
+        result = CliRunner().invoke(main, [name, "--help"])
+        assert f"-o, --output {metavar} " in result.output, (name, result.output)
+
+
+def test_every_size_option_reads_wxh():
+    for name in ("emulate", "device", "render-all", "compare"):
+        result = CliRunner().invoke(main, [name, "--help"])
+        assert "--size WxH " in result.output, name
+        args = ["a", "b"] if name == "compare" else ["-o", "x"]
+        bad = CliRunner().invoke(main, [name, *args, "--size", "12"])
+        assert bad.exit_code == 2 and "expected WIDTHxHEIGHT such as 512x384, not '12'" in bad.output, (name, bad.output)
+
+
 def test_help_imports_no_heavy_module():
     code = "import sys; from rend3r.cli import main; print(sorted({'numpy', 'scapy', 'PIL', 'lark'} & set(sys.modules)))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
@@ -24,7 +44,7 @@ def test_help_imports_no_heavy_module():
 def test_source_diagnostics_are_printed_once_without_a_second_prefix(tmp_path):
     src = tmp_path / "bad.asm"
     src.write_text("nr\ncam bogus, 1\ner\ner\n")
-    for args in (["emulate", str(src), "-o", str(tmp_path / "x.png")], ["send", str(src), "--mem", str(tmp_path / "x.mem")]):
+    for args in (["emulate", str(src), "-o", str(tmp_path / "x.png")], ["send", str(src), "-o", str(tmp_path / "x.mem")]):
         result = CliRunner().invoke(main, args)
         assert result.exit_code == 1
         assert "rend3r: error:" not in result.output
@@ -50,3 +70,13 @@ def test_ctrl_c_exits_130_without_a_traceback_or_output(tmp_path):
     assert proc.returncode == 130, err
     assert "Traceback" not in err and "interrupted" in err
     assert not out.exists()
+
+
+def test_exit_statuses_follow_one_convention(tmp_path):
+    """0 success, 1 an error, 2 a bad command line (130 for Ctrl-C: above)."""
+    src = tmp_path / "s.asm"
+    src.write_text("nr\ner\ner\n")
+    assert CliRunner().invoke(main, ["asm", str(src)]).exit_code == 0
+    assert CliRunner().invoke(main, ["asm", str(tmp_path / "missing.asm")]).exit_code == 1
+    assert CliRunner().invoke(main, ["asm", str(src), "--no-such-option"]).exit_code == 2
+    assert CliRunner().invoke(main, ["no-such-command"]).exit_code == 2

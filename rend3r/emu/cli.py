@@ -56,7 +56,7 @@ def _pattern(ctx, param, value: str | None) -> str | None:
 @click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormals: flush to zero (the device's IP) or IEEE gradual underflow.")
 @click.option("--size", type=SIZE, default="512x384", show_default=True, help="Image size WxH (1..8192 each).")
-@click.option("--background", default="0x0000", show_default=True, callback=_colour, help="RGB565 colour where no shape is hit.")
+@click.option("--background", default="0x0000", show_default=True, callback=_colour, metavar="RGB565", help="RGB565 colour where no shape is hit.")
 @click.option("--depth", "visibility", type=click.Choice(["zbuffer", "painter"]), default="zbuffer", show_default=True,
               help="Raster visibility: a depth buffer, or the paper's painter order by centroid distance.")
 @click.option("--depth-image", "depth_path", callback=_pattern, metavar="PATTERN", help="Depth image per frame: .npy (float32 distances) or 16-bit PNG.")

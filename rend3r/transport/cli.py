@@ -79,14 +79,14 @@ class _Progress:
 @click.option("--coe", "coe_out", metavar="FILE", hidden=True)  # -o FILE.coe
 @click.option("--pcap", "pcap_out", metavar="FILE", hidden=True)  # -o FILE.pcap
 @click.option("--serial", "port", metavar="PORT", help="Serial device path or pyserial URL (loop://, socket://, rfc2217://).")
-@click.option("--mac", default=DEFAULT_MAC, show_default=True, help="Device MAC address.")
+@click.option("--mac", default=DEFAULT_MAC, show_default=True, metavar="MAC", help="Device MAC address.")
 @click.option("--ethertype", default=f"0x{DEFAULT_ETHERTYPE:04x}", show_default=True, metavar="TYPE")
 @click.option("--framing", type=click.Choice(["protocol", "raw"]), default="protocol", show_default=True,
               help="raw: bare big-endian words, no header, no acknowledgement (the original receiver).")
 @click.option("--baud", type=int, default=115200, show_default=True, metavar="RATE")
-@click.option("--timeout", type=float, default=DEFAULT_TIMEOUT, show_default=True,
+@click.option("--timeout", type=float, default=DEFAULT_TIMEOUT, show_default=True, metavar="SECONDS",
               help="Seconds to wait for each acknowledgement.")
-@click.option("--retries", type=click.IntRange(0, 1000), default=DEFAULT_RETRIES, show_default=True,
+@click.option("--retries", type=click.IntRange(0, 1000), default=DEFAULT_RETRIES, show_default=True, metavar="N",
               help="Resends per frame (and restarts per load) before giving up.")
 @click.option("--run", "run_after", is_flag=True, help="Send RUN after the program is committed.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress or summary output.")
@@ -246,14 +246,14 @@ def serve(link: Link, core, stop: threading.Event, poll: float = 0.1) -> None:
 @click.option("--serial", "port", metavar="PORT", help="Serial device path or pyserial URL.")
 @click.option("-o", "--output", "out_dir", required=True, metavar="DIR",
               help="Folder for the rendered frames, runNNNN_frameFFFF.png (made if missing).")
-@click.option("--mac", default=DEFAULT_MAC, show_default=True, help="The MAC address the device answers to.")
-@click.option("--ethertype", default=f"0x{DEFAULT_ETHERTYPE:04x}", show_default=True)
-@click.option("--baud", type=int, default=115200, show_default=True)
-@click.option("--max-words", type=click.IntRange(1, 1 << 24), default=1 << 16, show_default=True,
+@click.option("--mac", default=DEFAULT_MAC, show_default=True, metavar="MAC", help="The MAC address the device answers to.")
+@click.option("--ethertype", default=f"0x{DEFAULT_ETHERTYPE:04x}", show_default=True, metavar="TYPE")
+@click.option("--baud", type=int, default=115200, show_default=True, metavar="RATE")
+@click.option("--max-words", type=click.IntRange(1, 1 << 24), default=1 << 16, show_default=True, metavar="N",
               help="Largest program accepted.")
 @click.option("--max-frame-rate", type=click.FloatRange(min=0, min_open=True), default=30.0,
-              show_default=True, help="Most frames rendered per second.")
-@click.option("--frames", "max_frames", type=click.IntRange(1), default=8, show_default=True,
+              show_default=True, metavar="FPS", help="Most frames rendered per second.")
+@click.option("--frames", "max_frames", type=click.IntRange(1), default=8, show_default=True, metavar="N",
               help="Frames rendered per program run (bounds looping programs).")
 @click.option("--size", type=SizeType(MAX_DEVICE_SIDE), default=DEVICE_SIZE, show_default=True,
               help=f"Rendered frame size (1..{MAX_DEVICE_SIDE} each); the board's is {DEVICE_SIZE}.")

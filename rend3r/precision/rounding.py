@@ -86,7 +86,7 @@ def round_to_format(fmt: FloatFormat, x: np.ndarray | float, *, tininess: Tinine
     """
     if tininess not in ("after", "before"):
         raise ValueError(f"tininess {tininess!r} must be 'after' or 'before'")
-    a = np.ascontiguousarray(x, dtype=np.float64)
+    a = np.asarray(x, dtype=np.float64)
     bits = a.view(np.uint64)
     mag = bits & _ABS
     g = _grid(fmt.exp_bits, fmt.frac_bits)
@@ -105,7 +105,10 @@ def _round_magnitudes(g: _Grid, mag: np.ndarray, drop: np.uint64 | np.ndarray,
                       direction: np.ndarray | None) -> np.ndarray:
     if np.ndim(drop) == 0 and drop == 0:
         return mag.copy()
-    tie = (mag >> drop) & _ONE
+    tie = (mag >> drop) & _ONE  # the lowest kept significand bit: ties go to even
+    if np.ndim(drop) > 0:  # a kept part of just the hidden bit is odd; of nothing, even (zero)
+        tie = np.where(drop == 52, (mag >> np.uint64(52)) != 0, tie).astype(np.uint64)
+        tie = np.where(drop == _WIDEST, np.uint64(0), tie)
     if direction is not None:
         tie = np.where(direction > 0, _ONE, np.where(direction < 0, np.uint64(0), tie))
     half = (_ONE << drop) >> _ONE
@@ -135,7 +138,7 @@ def _flush(g: _Grid, mag: np.ndarray, r: np.ndarray, tininess: Tininess,
 def midpoints(fmt: FloatFormat, x: np.ndarray) -> np.ndarray:
     """Lanes where a finite ``x`` lies exactly halfway between two neighbours of ``fmt``'s grid
     (the largest finite value and 2**(emax+1) count as neighbours)."""
-    a = np.ascontiguousarray(x, dtype=np.float64)
+    a = np.asarray(x, dtype=np.float64)
     mag = a.view(np.uint64) & _ABS
     g = _grid(fmt.exp_bits, fmt.frac_bits)
     drop = _drops(g, mag)

@@ -39,6 +39,15 @@ def _ethertype(text: str) -> int:
     return value
 
 
+def read_program(path: str):
+    """The program at ``path`` as a :class:`~rend3r.asm.program.Program`, loaded as
+    ``emulate`` loads it (source or any memory image, :func:`rend3r.emu.loader.load_program`)."""
+    from ..asm.program import Emitted, Program
+    from ..emu.loader import load_program
+
+    return Program([Emitted(0, tuple(load_program(path).words))])
+
+
 #: ``send -o FILE``: what each file suffix writes.
 OUTPUT_KINDS = {".mem": "mem", ".coe": "coe", ".pcap": "pcap"}
 
@@ -123,18 +132,16 @@ def send_command(program: str, output: str | None, iface: str | None, mem_out: s
     etype = _ethertype(ethertype)
     if run_after and kind in ("mem", "coe"):
         raise Rend3rError(f"--run needs a device (--eth, --serial) or a .pcap file, not a .{kind} file")
-    from ..emu.loader import load_program
-
-    words = load_program(program).words
+    prog = read_program(program)
+    words = prog.words
     say = (lambda msg: None) if quiet else (lambda msg: click.echo(msg, err=True))
     crc = program_crc(words)
 
     if kind in ("mem", "coe"):
         from ..asm.formats import render
-        from ..asm.program import Emitted, Program
         from ..fileio import write_atomic
 
-        write_atomic(out, render(kind, Program([Emitted(0, tuple(words))])))
+        write_atomic(out, render(kind, prog))
         say(f"wrote {plural(len(words), 'word')} (CRC-32 {crc:08x}) to {out}")
         return
     if kind == "pcap":

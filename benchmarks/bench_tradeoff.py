@@ -3,16 +3,18 @@
 Renders each ``programs/*.asm`` in fp16 (ftz), fp16 (ieee), fp32 and fp64 and reports per
 program and mode: median wall time per frame over ``--repeat`` runs, and the error against
 fp64 (PSNR, max channel error, share of differing pixels, silhouette pixels where hit/miss
-differs, pixels whose nearest shape differs). Writes ``docs/tradeoff.md`` (table and
-summary) and ``docs/tradeoff.png`` (time against error, one point per mode and program,
-drawn with Pillow).
+differs, pixels whose nearest shape differs). Writes ``tradeoff.md`` (table and summary)
+and ``tradeoff.png`` (time against error, one point per mode and program, drawn with
+Pillow) into ``--out`` (default ``docs/``): the folder is made before any measuring, and
+the two files are written together or not at all.
 
-    python benchmarks/bench_tradeoff.py [--size 256x192] [--repeat 3]
+    python benchmarks/bench_tradeoff.py [--size 256x192] [--repeat 3] [--out DIR]
 """
 
 from __future__ import annotations
 
 import argparse
+import io
 import math
 import statistics
 import sys
@@ -25,6 +27,7 @@ import numpy as np
 from rend3r.cliutil import parse_size
 from rend3r.emu import EmuOptions, load_program, run_program
 from rend3r.errors import Rend3rError
+from rend3r.fileio import make_output_folder, write_all
 from rend3r.golden.catalog import ExampleProgram, discover
 from rend3r.golden.metrics import image_metrics, provenance_metrics
 from rend3r.memory import reuse_freed_memory
@@ -154,8 +157,8 @@ def summary_sentences(rows: list[Row]) -> list[str]:
     ]
 
 
-def plot(rows: list[Row], path: Path) -> None:
-    """Time per frame (log x) against PSNR (y; identical frames at the top), with Pillow."""
+def plot(rows: list[Row]) -> bytes:
+    """PNG of time per frame (log x) against PSNR (y; identical frames at the top), with Pillow."""
     from PIL import Image, ImageDraw, ImageFont
 
     W, H, L, R, T, B = 900, 560, 80, 170, 40, 60
@@ -198,8 +201,9 @@ def plot(rows: list[Row], path: Path) -> None:
         y = T + 10 + 22 * i
         d.ellipse([W - R + 20, y - 5, W - R + 30, y + 5], fill=colour, outline="black")
         d.text((W - R + 38, y - 8), mode, fill="black", font=font)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    img.save(path)
+    png = io.BytesIO()
+    img.save(png, format="PNG")
+    return png.getvalue()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -212,6 +216,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", nargs="*", help="program names to measure (default: all)")
     args = ap.parse_args(argv)
     size = parse_size(args.size)
+    try:  # before any measuring: a folder that cannot be made fails now, not after minutes
+        out = make_output_folder(args.out)
+    except Rend3rError as exc:
+        print(f"rend3r: error: {exc}", file=sys.stderr)
+        return 1
     programs = [p for p in discover(args.programs) if not args.only or p.name in args.only]
     rows: list[Row] = []
     for program in programs:
@@ -231,9 +240,13 @@ def main(argv: list[str] | None = None) -> int:
         print("nothing measured", file=sys.stderr)
         return 1
     command = "python benchmarks/bench_tradeoff.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    (args.out / "tradeoff.md").write_text(markdown(rows, size, args.repeat, command.strip()), encoding="utf-8")
-    plot(rows, args.out / "tradeoff.png")
-    print(f"wrote {args.out / 'tradeoff.md'} and {args.out / 'tradeoff.png'}")
+    md, png = out / "tradeoff.md", out / "tradeoff.png"
+    try:
+        write_all([(md, markdown(rows, size, args.repeat, command.strip()).encode()), (png, plot(rows))])
+    except Rend3rError as exc:
+        print(f"rend3r: error: {exc}", file=sys.stderr)
+        return 1
+    print(f"wrote {md} and {png}")
     return 0
 
 

@@ -6,7 +6,9 @@ A line that is blank, a comment, one instruction whose operands are plain litera
 without the Lark parser. Anything else, and any line that would produce a diagnostic
 (a value out of range, a rounding warning, an SE with prop == prop2, an index beyond the
 target), returns None and goes through the full parser, which is the definition of the
-language. ``tests/asm/test_fastpath.py`` checks that both paths agree.
+language. Property tests check that both paths agree: ``tests/asm/test_fuzz.py``
+(``test_fast_path_agrees_with_grammar``, ``test_fast_word_agrees_with_grammar``,
+``test_fast_rounding_is_exact``) and ``tests/asm/test_isa_ext.py`` (under the extension).
 """
 
 from __future__ import annotations

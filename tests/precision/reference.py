@@ -9,7 +9,7 @@ nearest value of a format, ties to the even encoding, ``2**(emax+1)`` standing f
   (used for wider formats, and checked against :class:`Grid` on small ones).
 
 :func:`round_exact` adds signs, infinities and flush-to-zero; :func:`reference_op` applies
-an operation to two format values exactly (``fractions`` rules) and rounds once.
+an operation to two format values exactly (integer fractions) and rounds once.
 """
 
 from __future__ import annotations
@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 from bisect import bisect_right
 from collections.abc import Callable
-from fractions import Fraction
 
 from rend3r.precision.formats import FloatFormat
 
@@ -66,8 +65,10 @@ class Binades:
     def _finish(self, k: int, u: int, side: int) -> float:
         if side > 0 or (side == 0 and k % 2 == 1):
             k += 1
-        value = Fraction(k) * Fraction(2) ** u
-        return math.inf if value >= Fraction(2) ** (self.fmt.emax + 1) else float(value)
+        if k.bit_length() + u > self.fmt.emax + 1:  # k * 2**u >= 2**(emax + 1)
+            return math.inf
+        shift = max(k.bit_length() - 53, 0)  # only zeros below: k has at most M+1 bits
+        return math.ldexp(float(k >> shift), u + shift)
 
     def _quantum(self, e: int) -> int:
         return max(e, self.fmt.emin) - self.fmt.frac_bits
@@ -107,15 +108,13 @@ def rounder(fmt: FloatFormat) -> Grid | Binades:
     return Grid(fmt) if fmt.bits <= 16 else Binades(fmt)
 
 
-def round_exact(fmt: FloatFormat, rnd: Grid | Binades, x: Fraction, negative: bool,
+def round_exact(fmt: FloatFormat, rnd: Grid | Binades, n: int, d: int, negative: bool,
                 tininess: str = "after", sqrt: bool = False) -> float:
-    """The exact value ``x`` (or ``sqrt(x)``), of sign ``negative``, rounded to ``fmt``."""
-    n, d = abs(x).numerator, abs(x).denominator
+    """The exact value ``n/d >= 0`` (or its square root), of sign ``negative``, rounded to ``fmt``."""
     v = rnd.nearest_sqrt(n, d) if sqrt else rnd.nearest(n, d)
     if fmt.ftz:
-        m = Fraction(fmt.min_normal)
-        tiny = v < fmt.min_normal if tininess == "after" else (x < m * m if sqrt else abs(x) < m)
-        if tiny:
+        power = -2 * fmt.emin if sqrt else -fmt.emin  # exact < min normal: n * 2**-emin < d
+        if (v < fmt.min_normal) if tininess == "after" else ((n << power) < d):
             v = 0.0
     return -v if negative else v
 
@@ -129,21 +128,20 @@ def reference_op(fmt: FloatFormat, rnd: Grid | Binades, op: str, a: float, b: fl
                  tininess: str = "after") -> float:
     """``a op b`` (or ``sqrt(a)``) on finite format values, exactly, rounded once."""
     a, b = read(fmt, a), read(fmt, b)
-    fa, fb = Fraction(a), Fraction(b)
     sa, sb = math.copysign(1, a) < 0, math.copysign(1, b) < 0
+    (na, da), (nb, db) = a.as_integer_ratio(), b.as_integer_ratio()
     if op == "sqrt":
-        if fa < 0:
-            return math.nan
-        if fa == 0:
+        if na == 0:
             return a
-        return round_exact(fmt, rnd, fa, False, tininess, sqrt=True)
-    if op == "div" and fb == 0:
-        return math.nan if fa == 0 else (-math.inf if sa != sb else math.inf)
+        return math.nan if na < 0 else round_exact(fmt, rnd, na, da, False, tininess, sqrt=True)
+    if op == "div" and nb == 0:
+        return math.nan if na == 0 else (-math.inf if sa != sb else math.inf)
     if op in ("add", "sub"):
-        fb, sb = (-fb, not sb) if op == "sub" else (fb, sb)
-        x = fa + fb
-        negative = x < 0 or (x == 0 and sa and sb)
+        if op == "sub":
+            nb, sb = -nb, not sb
+        n, d = na * db + nb * da, da * db
+        negative = n < 0 or (n == 0 and sa and sb)
     else:
-        x = fa * fb if op == "mul" else fa / fb
+        n, d = (na * nb, da * db) if op == "mul" else (na * db, da * nb)
         negative = sa != sb
-    return round_exact(fmt, rnd, x, negative, tininess)
+    return round_exact(fmt, rnd, abs(n), abs(d), negative, tininess)

@@ -36,3 +36,17 @@ def test_click_type_exits_2_with_the_reason():
     assert CliRunner().invoke(cmd, []).output.strip() == "(4, 3)"
     r = CliRunner().invoke(cmd, ["--size", "100000x100000"])
     assert r.exit_code == 2 and "1..8192" in r.output
+
+
+def test_click_type_with_a_smaller_cap_and_the_wxh_metavar():
+    from rend3r.cliutil import SizeType
+
+    @click.command()
+    @click.option("--size", type=SizeType(64), default="64x48", show_default=True)
+    def cmd(size):
+        click.echo(repr(size))
+
+    assert "--size WxH" in CliRunner().invoke(cmd, ["--help"]).output
+    assert CliRunner().invoke(cmd, ["--size", "64x64"]).output.strip() == "(64, 64)"
+    r = CliRunner().invoke(cmd, ["--size", "65x1"])
+    assert r.exit_code == 2 and "1..64" in r.output

@@ -21,12 +21,13 @@
 #include "simd.h"
 #include "cull.h"
 
-/* Whether this processor runs the AVX2 build of the kernels (the _avx2 files of instances/). */
+/* Whether this processor runs the AVX2 build of the kernels (the _avx2 files of instances/,
+ * which also use F16C's float16 conversions). */
 int32_t have_avx2(void)
 {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
     __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") != 0;
+    return __builtin_cpu_supports("avx2") != 0 && __builtin_cpu_supports("f16c") != 0;
 #else
     return 0;
 #endif

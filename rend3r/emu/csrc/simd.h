@@ -32,24 +32,76 @@ typedef int32_t i32x4 __attribute__((vector_size(16)));
 /* Lanes of mask m: from a where set, else from b (integer vectors of one type). */
 #define SEL_BITS(m, a, b) (((a) & (m)) | ((b) & ~(m)))
 
+/* The sign bits of a mask's lanes as an int (lane i: bit i); masks are all ones or zero
+ * per lane. One instruction with AVX (the AVX2 kernels), two with SSE2. */
+#if defined(__AVX__)
+#include <immintrin.h>
+INLINE int mask_bits_32x8(i32x8 m) { return _mm256_movemask_ps((__m256)m); }
+INLINE int mask_bits_64x4(i64x4 m) { return _mm256_movemask_pd((__m256d)m); }
+#elif defined(__SSE2__)
+#include <emmintrin.h>
+typedef int64_t i64x2 __attribute__((vector_size(16)));
+INLINE int mask_bits_32x8(i32x8 m)
+{
+    return _mm_movemask_ps((__m128)__builtin_shufflevector(m, m, 0, 1, 2, 3))
+         | _mm_movemask_ps((__m128)__builtin_shufflevector(m, m, 4, 5, 6, 7)) << 4;
+}
+INLINE int mask_bits_64x4(i64x4 m)
+{
+    return _mm_movemask_pd((__m128d)__builtin_shufflevector(m, m, 0, 1))
+         | _mm_movemask_pd((__m128d)__builtin_shufflevector(m, m, 2, 3)) << 2;
+}
+#else
+INLINE int mask_bits_32x8(i32x8 m)
+{
+    int r = 0;
+    for (int i = 0; i < 8; i++)
+        r |= (m[i] < 0) << i;
+    return r;
+}
+INLINE int mask_bits_64x4(i64x4 m)
+{
+    int r = 0;
+    for (int i = 0; i < 4; i++)
+        r |= (m[i] < 0) << i;
+    return r;
+}
+#endif
+
 /* float16 rounding of 8 float lanes (fround.h round16, lane by lane): normal results by
  * integer rounding of the significand; overflow to infinity; NaN kept; below 2**-14
  * flushed (ftz; 2**-14 - 2**-25 and up go to 2**-14) or rounded to the subnormal grid
- * (adding and subtracting 2**23 rounds to an integer, nearest even). */
+ * (adding and subtracting 2**23 rounds to an integer, nearest even). The integer rounding
+ * is also exact for zeros and infinities (their low bits are zero), so only packets with a
+ * subnormal-range or overflowing lane take the rare path; NaN lanes are kept as they are. */
+#if defined(__F16C__)
+/* With F16C (every AVX2 processor), the conversion to float16 and back rounds as IEEE does,
+ * nearest even, subnormals included; ftz then flushes what came out below 2**-14 (so
+ * 2**-14 - 2**-25 and up still round to 2**-14, as round16 does), and NaN lanes are kept
+ * as they were. The same values as the integer rounding below, in fewer instructions. */
+INLINE f32x8 round16x8(f32x8 x, int ftz)
+{
+    f32x8 r = _mm256_cvtph_ps(_mm256_cvtps_ph((__m256)x, _MM_FROUND_TO_NEAREST_INT));
+    u32x8 b = (u32x8)r;
+    if (ftz)
+        b = SEL_BITS((u32x8)((i32x8)(b & 0x7FFFFFFFu) < 0x38800000), b & 0x80000000u, b);
+    return (f32x8)SEL_BITS((u32x8)(x != x), (u32x8)x, b);
+}
+#else
 static __attribute__((noinline)) f32x8 round16x8_rare(f32x8 x, int ftz);
 
 INLINE f32x8 round16x8(f32x8 x, int ftz)
 {
-    u32x8 b = (u32x8)x, a = b & 0x7FFFFFFFu;
-    u32x8 normal = (u32x8)((a >= 0x38800000u) & (a < 0x477FF000u));
-    int all = 1;
-    for (int i = 0; i < 8; i++)
-        all &= normal[i] != 0;
-    if (all)
-        return (f32x8)((b + 0xFFFu + ((b >> 13) & 1u)) & 0xFFFFE000u);
+    u32x8 b = (u32x8)x;
+    i32x8 a = (i32x8)(b & 0x7FFFFFFFu);  /* |x|'s bits: signed comparisons order them */
+    i32x8 rare = ((a > 0) & (a < 0x38800000)) | ((a >= 0x477FF000) & (a < 0x7F800000));
+    if (mask_bits_32x8(rare) == 0)
+        return (f32x8)SEL_BITS((u32x8)(a > 0x7F800000), b, (b + 0xFFFu + ((b >> 13) & 1u)) & 0xFFFFE000u);
     return round16x8_rare(x, ftz);
 }
+#endif
 
+#if !defined(__F16C__)
 /* round16x8 for packets with a lane that is zero, subnormal, overflowing or not finite:
  * out of line, so that the hundreds of roundings of a kernel stay small to compile. */
 static f32x8 round16x8_rare(f32x8 x, int ftz)
@@ -67,5 +119,7 @@ static f32x8 round16x8_rare(f32x8 x, int ftz)
     }
     return (f32x8)SEL_BITS(normal, r, SEL_BITS((u32x8)(a >= 0x477FF000u), big, small));
 }
+
+#endif
 
 #endif

@@ -48,7 +48,9 @@ def read(fmt: FloatFormat, a: np.ndarray | float) -> np.ndarray:
     """Operands as the format's units read them: float64, subnormals as signed zero with ftz."""
     v = np.asarray(a, dtype=np.float64)
     if fmt.ftz:
-        v = np.where(np.abs(v) < fmt.min_normal, np.copysign(0.0, v), v)
+        mag = np.abs(v)
+        if mag.size and mag.min() < fmt.min_normal:
+            v = np.where(mag < fmt.min_normal, np.copysign(0.0, v), v)
     return v
 
 
@@ -58,13 +60,12 @@ def _double_rounding_possible(fmt: FloatFormat) -> bool:
 
 def _finish(fmt: FloatFormat, r: np.ndarray, side: Side, tininess: Tininess) -> np.ndarray:
     """Round the float64 result ``r`` to ``fmt`` as the exact result would be rounded."""
-    need = np.zeros(r.shape, dtype=bool)
-    if _double_rounding_possible(fmt):
-        need |= midpoints(fmt, r)
+    need = midpoints(fmt, r) if _double_rounding_possible(fmt) else None
     if fmt.ftz and tininess == "before":
-        need |= np.abs(r) == fmt.min_normal
+        at_min = np.abs(r) == fmt.min_normal
+        need = at_min if need is None else need | at_min
     toward = None
-    if need.any():
+    if need is not None and need.any():
         toward = np.zeros(r.shape, dtype=np.int8)
         toward[need] = side(need)
     return round_to_format(fmt, r, tininess=tininess, toward=toward)

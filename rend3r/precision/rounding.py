@@ -59,20 +59,16 @@ def _grid(exp_bits: int, frac_bits: int) -> _Grid:
                  _bits(fmt.min_subnormal), _ABS & ~np.uint64((1 << drop) - 1))
 
 
-def _drops(g: _Grid, mag: np.ndarray) -> np.uint64 | np.ndarray:
-    """Bits to drop from each magnitude's pattern: a scalar while every value is normal in the
-    format, else per lane (52 - M plus one per binade below the smallest normal, capped)."""
-    if mag.size == 0 or mag.min() >= g.min_normal:
-        return np.uint64(g.drop)
+def _small_drops(g: _Grid, mag: np.ndarray) -> np.ndarray:
+    """Bits to drop below the smallest normal: 52 - M plus one per binade under it, capped
+    where the value is under the smallest subnormal."""
     field = np.maximum(mag >> np.uint64(52), _ONE).astype(np.int64)
     return np.minimum(g.drop + np.maximum(g.emin_field - field, 0), _WIDEST).astype(np.uint64)
 
 
-def _signed_toward(bits: np.ndarray, toward: np.ndarray | None) -> np.ndarray | None:
+def _signed_toward(bits: np.ndarray, toward: np.ndarray) -> np.ndarray:
     """``sign(exact - x)`` as a direction on the magnitude: +1 larger, -1 smaller, 0 exact."""
-    if toward is None:
-        return None
-    t = np.broadcast_to(np.asarray(toward, dtype=np.int8), bits.shape)
+    t = np.asarray(toward, dtype=np.int8)
     return np.where(bits & _SIGN != 0, -t, t)
 
 
@@ -87,65 +83,78 @@ def round_to_format(fmt: FloatFormat, x: np.ndarray | float, *, tininess: Tinine
     if tininess not in ("after", "before"):
         raise ValueError(f"tininess {tininess!r} must be 'after' or 'before'")
     a = np.asarray(x, dtype=np.float64)
-    bits = a.view(np.uint64)
+    shape = a.shape
+    bits = a.reshape(-1).view(np.uint64)  # flat, so 0-d values index like arrays
     mag = bits & _ABS
     g = _grid(fmt.exp_bits, fmt.frac_bits)
-    drop = _drops(g, mag)
-    direction = _signed_toward(bits, toward)
-    r = _round_magnitudes(g, mag, drop, direction)
+    direction = None if toward is None else _signed_toward(bits, np.broadcast_to(toward, shape).reshape(-1))
+    r = _round_normal(g, mag, direction)
+    small = np.flatnonzero(mag < g.min_normal) if mag.size and mag.min() < g.min_normal else None
+    if small is not None:  # the format's subnormal range, lane by lane
+        m = mag[small]
+        rs = _round_small(g, m, None if direction is None else direction[small])
+        if fmt.ftz:
+            rs[(rs < g.min_normal) if tininess == "after" else (m < g.min_normal)] = 0
+        r[small] = rs
+    if fmt.ftz and tininess == "before" and direction is not None:
+        r[(mag == g.min_normal) & (direction < 0)] = 0  # the exact value lies just below it
     if r.size and r.max() >= g.overflow:  # overflow, infinities or NaNs present
-        r = np.where(r >= g.overflow, _INF, r)
-        r = np.where(mag > _INF, (mag & g.nan_keep) | _QUIET, r)
-    if fmt.ftz:
-        r = _flush(g, mag, r, tininess, direction, below_normal=np.ndim(drop) > 0)
-    return (r | (bits & _SIGN)).view(np.float64)
+        r[r >= g.overflow] = _INF
+        nan = mag > _INF
+        r[nan] = (mag[nan] & g.nan_keep) | _QUIET
+    r |= bits & _SIGN
+    return r.view(np.float64).reshape(shape)
 
 
-def _round_magnitudes(g: _Grid, mag: np.ndarray, drop: np.uint64 | np.ndarray,
-                      direction: np.ndarray | None) -> np.ndarray:
-    if np.ndim(drop) == 0 and drop == 0:
+def _tie_bits(tie: np.ndarray, direction: np.ndarray | None) -> np.ndarray:
+    if direction is None:
+        return tie
+    return np.where(direction > 0, _ONE, np.where(direction < 0, np.uint64(0), tie))
+
+
+def _round_normal(g: _Grid, mag: np.ndarray, direction: np.ndarray | None) -> np.ndarray:
+    """Every lane rounded as if in the format's normal range (a fresh array)."""
+    drop = np.uint64(g.drop)
+    if g.drop == 0:
         return mag.copy()
-    tie = (mag >> drop) & _ONE  # the lowest kept significand bit: ties go to even
-    if np.ndim(drop) > 0:  # a kept part of just the hidden bit is odd; of nothing, even (zero)
-        tie = np.where(drop == 52, (mag >> np.uint64(52)) != 0, tie).astype(np.uint64)
-        tie = np.where(drop == _WIDEST, np.uint64(0), tie)
-    if direction is not None:
-        tie = np.where(direction > 0, _ONE, np.where(direction < 0, np.uint64(0), tie))
-    half = (_ONE << drop) >> _ONE
-    r = (mag + half - _ONE + tie) & ~((_ONE << drop) - _ONE)
-    if np.ndim(drop) == 0:
-        return r
-    if g.drop == 0:  # 52 fraction bits: the normal range is float64's own
-        r = np.where(drop == 0, mag, r)
-    widest = drop == _WIDEST
-    if widest.any():  # [0, q): zero or the smallest subnormal
-        up = (mag > g.half_q) | ((mag == g.half_q) & (tie == _ONE))
-        r = np.where(widest, np.where(up, g.q, np.uint64(0)), r)
+    r = np.right_shift(mag, drop)
+    r &= _ONE  # the lowest kept bit: ties go to even
+    r = _tie_bits(r, direction)
+    r += ((_ONE << drop) >> _ONE) - _ONE
+    r += mag
+    r &= ~((_ONE << drop) - _ONE)
     return r
 
 
-def _flush(g: _Grid, mag: np.ndarray, r: np.ndarray, tininess: Tininess,
-           direction: np.ndarray | None, below_normal: bool) -> np.ndarray:
-    """Flush-to-zero: results tiny after rounding, or exact values tiny before it."""
-    if tininess == "after":
-        return np.where(r < g.min_normal, np.uint64(0), r) if below_normal else r
-    tiny = mag < g.min_normal
-    if direction is not None:  # x is the smallest normal, the exact value just below it
-        tiny |= (mag == g.min_normal) & (direction < 0)
-    return np.where(tiny, np.uint64(0), r)
+def _round_small(g: _Grid, mag: np.ndarray, direction: np.ndarray | None) -> np.ndarray:
+    """Magnitudes below the smallest normal rounded to the subnormal grid (no flushing)."""
+    drop = _small_drops(g, mag)
+    tie = (mag >> drop) & _ONE
+    # a kept part of just the hidden bit is odd; of nothing (under the smallest subnormal), even
+    tie = np.where(drop == 52, (mag >> np.uint64(52)) != 0, tie).astype(np.uint64)
+    tie = _tie_bits(np.where(drop == _WIDEST, np.uint64(0), tie), direction)
+    r = (mag + ((_ONE << drop) >> _ONE) - _ONE + tie) & ~((_ONE << drop) - _ONE)
+    r = np.where(drop == 0, mag, r)  # 11 exponent and 52 fraction bits: float64's own grid
+    up = (mag > g.half_q) | ((mag == g.half_q) & (tie == _ONE))
+    return np.where(drop == _WIDEST, np.where(up, g.q, np.uint64(0)), r)
 
 
 def midpoints(fmt: FloatFormat, x: np.ndarray) -> np.ndarray:
     """Lanes where a finite ``x`` lies exactly halfway between two neighbours of ``fmt``'s grid
     (the largest finite value and 2**(emax+1) count as neighbours)."""
     a = np.asarray(x, dtype=np.float64)
-    mag = a.view(np.uint64) & _ABS
+    mag = a.reshape(-1).view(np.uint64) & _ABS
     g = _grid(fmt.exp_bits, fmt.frac_bits)
-    drop = _drops(g, mag)
-    if np.ndim(drop) == 0 and drop == 0:
-        return np.zeros(a.shape, dtype=bool)
-    half = (_ONE << drop) >> _ONE
-    on_half = ((mag & ((_ONE << drop) - _ONE)) == half) & (half != 0) & (mag < _INF)
-    if np.ndim(drop) == 0:
-        return on_half
-    return np.where(drop == _WIDEST, mag == g.half_q, on_half)
+    if g.drop == 0:
+        on_half = np.zeros(mag.shape, dtype=bool)
+    else:
+        low = mag & np.uint64((1 << g.drop) - 1)
+        on_half = (low == np.uint64(1 << (g.drop - 1))) & (mag < _INF)
+    if mag.size and mag.min() < g.min_normal:
+        small = np.flatnonzero(mag < g.min_normal)
+        m = mag[small]
+        drop = _small_drops(g, m)
+        half = (_ONE << drop) >> _ONE
+        mid = np.where(drop == _WIDEST, m == g.half_q, ((m & ((_ONE << drop) - _ONE)) == half) & (half != 0))
+        on_half[small] = mid
+    return on_half.reshape(a.shape)

@@ -11,6 +11,8 @@ module uart_rx #(
     output reg        err
 );
     localparam CW = $clog2(CLKS_PER_BIT + 1);
+    localparam [31:0] BIT_LAST = CLKS_PER_BIT - 1;  // cut to CW bits where used: no width warning
+    localparam [31:0] BIT_HALF = CLKS_PER_BIT / 2;
     reg [1:0] sync;
     reg [CW-1:0] timer;
     reg [3:0] bitn;
@@ -30,13 +32,13 @@ module uart_rx #(
             if (!busy) begin
                 if (!line) begin  // start bit edge: sample it again half a bit later
                     busy <= 1'b1;
-                    timer <= CLKS_PER_BIT / 2;
+                    timer <= BIT_HALF[CW-1:0];
                     bitn <= 0;
                 end
             end else if (timer != 0) begin
                 timer <= timer - 1'b1;
             end else begin
-                timer <= CLKS_PER_BIT - 1;
+                timer <= BIT_LAST[CW-1:0];
                 bitn <= bitn + 1'b1;
                 if (bitn == 0) begin
                     if (line) busy <= 1'b0;  // glitch, not a start bit

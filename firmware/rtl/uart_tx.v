@@ -10,6 +10,7 @@ module uart_tx #(
     output wire       tx
 );
     localparam CW = $clog2(CLKS_PER_BIT + 1);
+    localparam [31:0] BIT_LAST = CLKS_PER_BIT - 1;  // cut to CW bits where used: no width warning
     reg [9:0] shift;  // stop, data[7:0], start; shifted out LSB first
     reg [3:0] left;
     reg [CW-1:0] timer;
@@ -26,12 +27,12 @@ module uart_tx #(
             if (valid) begin
                 shift <= {1'b1, data, 1'b0};
                 left <= 4'd10;
-                timer <= CLKS_PER_BIT - 1;
+                timer <= BIT_LAST[CW-1:0];
             end
         end else if (timer != 0) begin
             timer <= timer - 1'b1;
         end else begin
-            timer <= CLKS_PER_BIT - 1;
+            timer <= BIT_LAST[CW-1:0];
             shift <= {1'b1, shift[9:1]};
             left <= left - 1'b1;
         end

@@ -98,11 +98,13 @@ class Pins:
         dut = self.dut
         while True:
             await RisingEdge(dut.rmii_tx_en)
-            await RisingEdge(dut.clk)
+            # Sample mid-cycle: at a rising edge Icarus shows the flops' old values and
+            # Verilator their new ones; at the falling edge both show the same.
+            await FallingEdge(dut.clk)
             bits: list[int] = []
             while dut.rmii_tx_en.value:
                 bits.append(int(dut.rmii_txd.value))
-                await RisingEdge(dut.clk)
+                await FallingEdge(dut.clk)
             raw = bytes(sum(bits[i + k] << (2 * k) for k in range(4)) for i in range(0, len(bits) - 3, 4))
             if len(bits) % 4 or not raw.startswith(PREAMBLE) or len(raw) < len(PREAMBLE) + 64:
                 self.bad_replies += 1

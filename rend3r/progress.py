@@ -10,6 +10,7 @@ runs, and tests, see nothing. Work whose length is known up front reports units 
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from types import TracebackType
 from typing import TextIO
 
@@ -44,6 +45,16 @@ class Progress:
                  tb: TracebackType | None) -> None:
         if self._bar is not None:
             self._bar.render_finish()
+
+
+ProgressFactory = Callable[[int, str], Progress]
+"""What library code takes to report progress: ``factory(total, label)`` -> a :class:`Progress`
+(``functools.partial(Progress, quiet=quiet)`` in a command; :func:`hidden` by default)."""
+
+
+def hidden(total: int, label: str) -> Progress:
+    """A bar that draws nothing: the default where a caller asks for no progress."""
+    return Progress(total, label, quiet=True)
 
 
 def quiet_option(function):

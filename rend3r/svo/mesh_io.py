@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import Rend3rError
 from ..fileio import read_limited, write_atomic
+from .octree import sorted_unique
 
 Mesh = tuple[np.ndarray, np.ndarray]
 MAX_MESH = 64 << 20
@@ -254,15 +255,22 @@ def read_mesh(path: str | os.PathLike[str]) -> Mesh:
     raise AssertionError(ext)  # every extension above returns
 
 
-def write_mesh(path: str | os.PathLike[str], verts: np.ndarray, faces: np.ndarray,
-               binary: bool = True) -> None:
-    """Write a mesh as OBJ, PLY or STL by extension (PLY/STL binary unless ``binary=False``)."""
+def encode_mesh(path: str | os.PathLike[str], verts: np.ndarray, faces: np.ndarray,
+                binary: bool = True) -> bytes:
+    """A mesh's bytes as OBJ, PLY or STL by ``path``'s extension (PLY/STL binary unless
+    ``binary=False``); Rend3rError for any other extension."""
     ext = Path(path).suffix.lower()
     formats = {".obj": lambda: format_obj(verts, faces), ".ply": lambda: format_ply(verts, faces, binary),
                ".stl": lambda: format_stl(verts, faces, binary)}
     if ext not in formats:
         raise Rend3rError(f"{path}: unknown mesh format (use .obj, .ply or .stl)")
-    write_atomic(path, formats[ext]())
+    return formats[ext]()
+
+
+def write_mesh(path: str | os.PathLike[str], verts: np.ndarray, faces: np.ndarray,
+               binary: bool = True) -> None:
+    """Write a mesh atomically (:func:`encode_mesh`)."""
+    write_atomic(path, encode_mesh(path, verts, faces, binary))
 
 
 def _binvox_index(coords: np.ndarray, dim: int) -> np.ndarray:
@@ -273,7 +281,7 @@ def encode_binvox(coords: np.ndarray, dim: int, translate=(0.0, 0.0, 0.0), scale
     """binvox bytes for sparse voxels; runs are built from the sorted indices, never a dense grid."""
     header = (f"#binvox 1\ndim {dim} {dim} {dim}\ntranslate {translate[0]:.9g} {translate[1]:.9g} "
               f"{translate[2]:.9g}\nscale {scale:.9g}\ndata\n").encode()
-    idx = np.unique(_binvox_index(np.asarray(coords, dtype=np.int64).reshape(-1, 3), dim))
+    idx = sorted_unique(_binvox_index(np.asarray(coords, dtype=np.int64).reshape(-1, 3), dim))
     total = dim ** 3
     if len(idx):
         brk = np.flatnonzero(np.diff(idx) != 1)

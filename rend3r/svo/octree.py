@@ -41,6 +41,16 @@ def popcount8(x: np.ndarray) -> np.ndarray:
     return _POPCOUNT8[np.asarray(x, dtype=np.int64) & 0xFF]
 
 
+def sorted_unique(values: np.ndarray) -> np.ndarray:
+    """The sorted distinct values of a 1-D array, as ``np.unique`` returns them.
+
+    A sort and a mask: numpy 2.4's ``np.unique`` took 35 s for 11 M int64 keys on the
+    project's machine, where this takes 0.5 s (and a Ctrl-C waits for the call to return).
+    """
+    values = np.sort(values)
+    return values[np.r_[True, values[1:] != values[:-1]]] if len(values) else values
+
+
 def morton_encode(coords: np.ndarray, depth: int) -> np.ndarray:
     """Interleave voxel coordinates (M, 3) into codes: per level the triple (x, y, z), x high."""
     c = np.asarray(coords, dtype=np.int64)

@@ -17,9 +17,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import Rend3rError
+from ..progress import ProgressFactory, hidden
 from .budget import FILL_BYTES, SURFACE_BYTES, check_budget, estimate_voxels
 from .budget import max_voxels as voxel_limit
-from .octree import morton_decode, morton_encode
+from .octree import morton_decode, morton_encode, sorted_unique
 
 _CHUNK = 1 << 19  # candidate (triangle, voxel) pairs per vectorised batch
 MAX_COORD = 1e150
@@ -125,7 +126,7 @@ def _batches(weights: np.ndarray, limit: int):
 
 def _keys(coords: np.ndarray, n: int) -> np.ndarray:
     """Sorted unique linear keys ``(x*n + y)*n + z`` of voxel coordinates."""
-    return np.unique((coords[:, 0] * n + coords[:, 1]) * n + coords[:, 2])
+    return sorted_unique((coords[:, 0] * n + coords[:, 1]) * n + coords[:, 2])
 
 
 def _rows(keys: np.ndarray, n: int) -> np.ndarray:
@@ -168,24 +169,28 @@ def voxelize_surface(tri_grid: np.ndarray, n: int, max_voxels: int | None = None
     return _rows(_surface_keys(tri_grid, n, lambda c: _keys(c, n), max_voxels), n)
 
 
-def _surface_keys(tri_grid: np.ndarray, n: int, key, max_voxels: int | None) -> np.ndarray:
-    """Sorted unique ``key(coords)`` of the voxels the triangles overlap, batch by batch."""
+def _surface_keys(tri_grid: np.ndarray, n: int, key, max_voxels: int | None,
+                  progress: ProgressFactory = hidden) -> np.ndarray:
+    """Sorted unique ``key(coords)`` of the voxels the triangles overlap, batch by batch
+    (``progress``'s bar counts candidate voxels)."""
     tri_grid = tri_grid[np.any(np.cross(tri_grid[:, 1] - tri_grid[:, 0], tri_grid[:, 2] - tri_grid[:, 0]), axis=1)]
     tri_grid = _split_large(tri_grid, n)
     weight = _weight(tri_grid, n)
     # batches keep only their unique keys (8 bytes a voxel) until the final merge
     keys: list[np.ndarray] = []
     held = 0
-    for s in _batches(weight, _CHUNK):
-        keys.append(np.unique(key(_surface_chunk(tri_grid[s], n))))
-        held += len(keys[-1])
-        if max_voxels is not None and held > max_voxels:
-            keys = [np.unique(np.concatenate(keys))]
-            held = len(keys[0])
-            if held > max_voxels:
-                raise Rend3rError(f"the surface holds more than {max_voxels:,} voxels, the most the memory "
-                                  "budget allows (--max-memory; use a smaller --depth)")
-    return np.unique(np.concatenate(keys)) if keys else np.empty(0, np.int64)
+    with progress(int(weight.sum()), "voxelising") as bar:
+        for s in _batches(weight, _CHUNK):
+            keys.append(sorted_unique(key(_surface_chunk(tri_grid[s], n))))
+            bar.advance(int(weight[s].sum()))
+            held += len(keys[-1])
+            if max_voxels is not None and held > max_voxels:
+                keys = [sorted_unique(np.concatenate(keys))]
+                held = len(keys[0])
+                if held > max_voxels:
+                    raise Rend3rError(f"the surface holds more than {max_voxels:,} voxels, the most the memory "
+                                      "budget allows (--max-memory; use a smaller --depth)")
+    return sorted_unique(np.concatenate(keys)) if keys else np.empty(0, np.int64)
 
 
 def fill_solid(tri_grid: np.ndarray, n: int, max_voxels: int | None = None) -> np.ndarray:
@@ -242,13 +247,15 @@ def voxelize(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool = Fal
 
 
 def voxelize_codes(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool = False,
-                   budget: int | None = None) -> tuple[np.ndarray, np.ndarray, float]:
+                   budget: int | None = None, progress: ProgressFactory = hidden
+                   ) -> tuple[np.ndarray, np.ndarray, float]:
     """Voxelise a triangle mesh: (sorted unique Morton codes (M,), lo corner, voxel size h).
 
     Codes (8 bytes a voxel) are what the octree builder sorts; coordinates are never held
     for the whole mesh. With ``budget`` (bytes) the build is refused up front when its
     estimate (:mod:`rend3r.svo.budget`) exceeds it, and again on the exact counts of the
-    surface batches and the solid fill before they are expanded.
+    surface batches and the solid fill before they are expanded. ``progress(total, label)``
+    makes the bar of the surface batches.
     """
     faces = np.asarray(faces, dtype=np.int64)
     if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) == 0:
@@ -262,11 +269,11 @@ def voxelize_codes(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool
     if budget is not None:
         check_budget(estimate_voxels(tri, n, solid), budget, f"depth {depth}{' solid' if solid else ''}")
         limit = voxel_limit(budget)
-    codes = _surface_keys(tri, n, lambda c: morton_encode(c, depth), limit)
+    codes = _surface_keys(tri, n, lambda c: morton_encode(c, depth), limit, progress)
     if len(codes) == 0:
         raise Rend3rError("mesh has no area: every triangle has equal or collinear vertices")
     if solid:
         room = None if budget is None else voxel_limit(budget - SURFACE_BYTES * len(codes), FILL_BYTES)
         fill = fill_solid(tri, n, room)
-        codes = np.union1d(codes, morton_encode(fill, depth))
+        codes = sorted_unique(np.concatenate([codes, morton_encode(fill, depth)]))
     return codes, lo, h

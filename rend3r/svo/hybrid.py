@@ -10,6 +10,8 @@ distances. On equal distances the REND3R frame's pixel is kept.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from ..errors import Rend3rError
@@ -64,14 +66,15 @@ def merge(svo_rgb565: np.ndarray, svo_dist: np.ndarray, frame_rgb565: np.ndarray
 
 
 def program_hybrid(model, program: str, model_matrix: np.ndarray, width: int, height: int,
-                   stack_depth: int = 8, frames: int = 1, kernel: str = "auto"
+                   stack_depth: int = 8, frames: int = 1, kernel: str = "auto",
+                   on_rays: Callable[[int], None] | None = None
                    ) -> list[tuple[np.ndarray, np.ndarray]]:
     """Run a REND3R program in the emulator and merge the SVO into each of its frames.
 
     The SVO is traced with the emulator's own primary rays for the frame (same camera),
     taken into octree space by the inverse of ``model_matrix``; a hit's distance is
-    ``t * |d|`` in world space, the emulator's depth convention.
-    Returns (rgb565, distance) per frame.
+    ``t * |d|`` in world space, the emulator's depth convention. ``on_rays(count)`` is
+    called as the SVO's rays are traced. Returns (rgb565, distance) per frame.
     """
     from ..emu import EmuOptions, run_program
     from ..emu.camera import camera_rays
@@ -99,7 +102,8 @@ def program_hybrid(model, program: str, model_matrix: np.ndarray, width: int, he
             raise Rend3rError(f"{program}: frame {frame.number}: the camera produces non-finite or zero rays")
         o_oct = inv[:3, :3] @ o + inv[:3, 3]
         d_oct = d @ inv[:3, :3].T
-        res = trace(model.tree, np.broadcast_to(o_oct, d.shape), d_oct, stack_depth, kernel=kernel)
+        res = trace(model.tree, np.broadcast_to(o_oct, d.shape), d_oct, stack_depth, kernel=kernel,
+                    on_rays=on_rays)
         dist = np.where(res.hit, res.t * np.linalg.norm(d, axis=1), np.inf)
         rgb = shade(res, d_oct, dist, "shaded", height, width)
         out.append(merge(rgb888_to_565(rgb), dist.reshape(height, width).astype(np.float32),

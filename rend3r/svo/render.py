@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,13 +50,15 @@ def shade(result: TraceResult, direction: np.ndarray, dist: np.ndarray, mode: st
 
 
 def render(model: SvoModel, cam: Camera, stack_depth: int = 8, fixed: bool = True,
-           mode: str = "shaded", record: bool = False, kernel: Kernel = "auto") -> Render:
+           mode: str = "shaded", record: bool = False, kernel: Kernel = "auto",
+           on_rays: Callable[[int], None] | None = None) -> Render:
     """Trace one frame; hits beyond the far plane (t > 1) count as misses.
 
-    ``kernel``: traversal implementation (:func:`rend3r.svo.traverse.resolve_kernel`).
+    ``kernel``: traversal implementation (:func:`rend3r.svo.traverse.resolve_kernel`);
+    ``on_rays(count)``: called as chunks of rays are traced (:func:`rend3r.svo.traverse.trace`).
     """
     rays = primary_rays(cam, model_matrix(model.bounds))
-    res = trace(model.tree, rays.origin, rays.direction, stack_depth, fixed, record, kernel)
+    res = trace(model.tree, rays.origin, rays.direction, stack_depth, fixed, record, kernel, on_rays)
     beyond = res.hit & (res.t > 1.0)
     res.hit[beyond] = False
     res.t[beyond] = np.inf

@@ -11,15 +11,19 @@ from __future__ import annotations
 import csv
 import io
 import multiprocessing
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ..progress import ProgressFactory, hidden
 from .cache import CacheConfig, simulate
 from .camera import orbit_camera
 from .cores import Platform, compute_cycles, frame_time
 from .fileformat import SvoModel
+from .interrupt import ignore_sigint_in_worker, sigint_blocked
 from .render import render
+from .traverse import Kernel
 
 
 @dataclass(frozen=True)
@@ -65,12 +69,12 @@ def thesis_points() -> list[DesignPoint]:
 _TRACES: dict[int, list[dict[str, np.ndarray]]] = {}
 
 
-def _trace_views(model: SvoModel, stack: int, views: int, width: int, height: int
-                 ) -> list[dict[str, np.ndarray]]:
+def _trace_views(model: SvoModel, stack: int, views: int, width: int, height: int, kernel: Kernel,
+                 on_rays: Callable[[int], None] | None) -> list[dict[str, np.ndarray]]:
     out = []
     for v in range(views):
         cam = orbit_camera(model.bounds, azimuth=35.0 + 360.0 * v / views, width=width, height=height)
-        res = render(model, cam, stack, True, "depth", record=True).result
+        res = render(model, cam, stack, True, "depth", record=True, kernel=kernel, on_rays=on_rays).result
         out.append({
             "compute": compute_cycles(res.steps, res.descents, res.pops, res.restarts, res.requests),
             "requests": res.requests, "ray": res.trace_ray, "addr": res.trace_addr,
@@ -105,20 +109,38 @@ def _evaluate(job: tuple[int, int, int, int, int | None, tuple[tuple[int, str], 
 
 
 def run_sweep(model: SvoModel, points: list[DesignPoint], width: int = 320, height: int = 240,
-              views: int = 1, jobs: int = 2) -> list[dict]:
-    """Evaluate ``points``; returns one row per point (see :data:`COLUMNS`)."""
+              views: int = 1, jobs: int = 2, progress: ProgressFactory = hidden,
+              kernel: Kernel = "auto") -> list[dict]:
+    """Evaluate ``points``; returns one row per point (see :data:`COLUMNS`).
+
+    ``kernel`` traces the frames (:func:`rend3r.svo.traverse.resolve_kernel`; the rows do
+    not depend on it).
+    ``progress(total, label)`` makes the bars of the two stages: tracing (rays) and
+    simulating the caches and cores (design points). Worker processes ignore Ctrl-C; the
+    KeyboardInterrupt it raises here ends them.
+    """
     _TRACES.clear()
-    for stack in sorted({p.stack for p in points}):
-        _TRACES[stack] = _trace_views(model, stack, views, width, height)
+    stacks = sorted({p.stack for p in points})
+    with progress(len(stacks) * views * width * height, "tracing") as bar:
+        for stack in stacks:
+            _TRACES[stack] = _trace_views(model, stack, views, width, height, kernel, bar.advance)
     groups: dict[tuple, list[tuple[int, str]]] = {}
     for p in points:
         groups.setdefault((p.stack, p.cache, p.block, p.ways, p.max_level), []).append((p.cores, p.policy))
     tasks = [key + (tuple(runs),) for key, runs in groups.items()]
-    if jobs > 1 and len(tasks) > 1:
-        with multiprocessing.get_context("fork").Pool(jobs) as pool:
-            results = pool.map(_evaluate, tasks, chunksize=1)
-    else:
-        results = [_evaluate(t) for t in tasks]
+    results = []
+    with progress(len(points), "simulating") as bar:
+        if jobs > 1 and len(tasks) > 1:
+            with sigint_blocked():  # workers start with Ctrl-C held back until they ignore it
+                pool = multiprocessing.get_context("fork").Pool(jobs, ignore_sigint_in_worker)
+            with pool:  # on leaving, even by Ctrl-C, the workers are terminated
+                for rows in pool.imap(_evaluate, tasks, chunksize=1):
+                    results.append(rows)
+                    bar.advance(len(rows))
+        else:
+            for task in tasks:
+                results.append(_evaluate(task))
+                bar.advance(len(results[-1]))
     return [row for rows in results for row in rows]
 
 

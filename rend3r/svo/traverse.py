@@ -34,6 +34,7 @@ to this one on every output; ``trace(kernel=...)`` chooses.
 from __future__ import annotations
 
 import importlib
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
@@ -44,6 +45,10 @@ from .octree import Octree, child_table, morton_decode, popcount8
 
 Kernel = Literal["auto", "numba", "numpy"]
 KERNELS: tuple[str, ...] = ("auto", "numba", "numpy")
+#: rays per traversal call: the compiled kernel takes about 10 ms for 2^14 rays, the numpy
+#: lockstep needs larger batches to stay efficient (each of its steps is a few dozen numpy
+#: calls over the batch), and is interruptible inside a batch anyway
+CHUNK_RAYS = {"numba": 1 << 14, "numpy": 1 << 16}
 _AXIS_BIT = (4, 2, 1)
 #: _SIDE[i, a]: child index i is on the high side of axis a's middle plane
 _SIDE = ((np.arange(8)[:, None] >> np.array([2, 1, 0])) & 1).astype(bool)
@@ -93,6 +98,17 @@ def _first_index(t0: list, t1: list, fixed: bool) -> np.ndarray:
     return idx
 
 
+def _check_rays(o: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """The rays' |d| (n,); ValueError counting the rays with a non-finite origin or a zero or
+    non-finite direction."""
+    # |d| summed in a fixed order (the compiled kernel repeats it operation for operation)
+    scale = np.sqrt((d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]) + d[:, 2] * d[:, 2])
+    bad = ~np.isfinite(scale) | (scale == 0) | ~np.all(np.isfinite(o), axis=1)
+    if bad.any():
+        raise ValueError(f"{int(bad.sum())} rays have a non-finite origin or a zero/non-finite direction")
+    return scale
+
+
 def setup_rays(origin: np.ndarray, direction: np.ndarray):
     """Ray setup: (hits root, dir-mask, root t0 (3, n), root t1 (3, n), shift, scale).
 
@@ -102,11 +118,7 @@ def setup_rays(origin: np.ndarray, direction: np.ndarray):
     """
     o = np.asarray(origin, dtype=np.float64).reshape(-1, 3)
     d = np.asarray(direction, dtype=np.float64).reshape(-1, 3)
-    # |d| summed in a fixed order (the compiled kernel repeats it operation for operation)
-    scale = np.sqrt((d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]) + d[:, 2] * d[:, 2])
-    bad = ~np.isfinite(scale) | (scale == 0) | ~np.all(np.isfinite(o), axis=1)
-    if bad.any():
-        raise ValueError(f"{int(bad.sum())} rays have a non-finite origin or a zero/non-finite direction")
+    scale = _check_rays(o, d)
     dn = clamp_direction(d / scale[:, None])
     neg = dn < 0
     dmask = (neg[:, 0] * 4 + neg[:, 1] * 2 + neg[:, 2]).astype(np.int64)
@@ -147,23 +159,63 @@ def resolve_kernel(kernel: str, fixed: bool = True) -> tuple[str, str | None]:
 
 
 def trace(tree: Octree, origin: np.ndarray, direction: np.ndarray, stack_depth: int = 8,
-          fixed: bool = True, record: bool = False, kernel: Kernel = "auto") -> TraceResult:
+          fixed: bool = True, record: bool = False, kernel: Kernel = "auto",
+          on_rays: Callable[[int], None] | None = None) -> TraceResult:
     """Trace rays ``origin + t * direction`` (octree space, root = [-1, 1]^3).
 
     ``stack_depth`` is the short stack's depth (0 = restart only); when full, a push
     drops the oldest entry. ``fixed`` selects 16.16 arithmetic (else float64). With
     ``record`` the memory requests are returned in ray-major order for cache models.
     ``kernel`` selects the implementation (see :func:`resolve_kernel`; results are
-    identical).
+    identical). The rays are traced in chunks (:data:`CHUNK_RAYS`), so a Ctrl-C is seen
+    between chunks; ``on_rays(count)`` is called after each with the rays it traced.
     """
     if stack_depth < 0:
         raise ValueError("stack depth must be >= 0")
     use, _ = resolve_kernel(kernel, fixed)
+    o = np.asarray(origin, dtype=np.float64).reshape(-1, 3)
+    d = np.asarray(direction, dtype=np.float64).reshape(-1, 3)
+    if len(o) != len(d):
+        o, d = np.broadcast_arrays(o, d)
+    _check_rays(o, d)
     # a step cap far above any correct traversal; reaching it means a bug, not a hard ray
     limit = 64 * 8 * (tree.depth + 1) * (1 << min(tree.depth, 12))
     root_table = int(child_table(tree.words, np.zeros(1, dtype=np.int64))[0][0])
     if use == "numba":
-        return _trace_numba(tree, origin, direction, root_table, stack_depth, limit, record)
+        from .interrupt import off_main_thread
+
+        def one(lo: int, hi: int) -> TraceResult:
+            return off_main_thread(_trace_numba, tree, o[lo:hi], d[lo:hi], root_table,
+                                   stack_depth, limit, record)
+    else:
+        def one(lo: int, hi: int) -> TraceResult:
+            return _trace_numpy(tree, o[lo:hi], d[lo:hi], root_table, stack_depth, fixed,
+                                limit, record)
+    step = CHUNK_RAYS[use]
+    parts = []
+    for lo in range(0, max(len(o), 1), step):  # no rays: one empty chunk
+        parts.append(one(lo, min(lo + step, len(o))))
+        if on_rays is not None:
+            on_rays(len(parts[-1].hit))
+    return _concatenate(parts, record) if len(parts) != 1 else parts[0]
+
+
+def _concatenate(parts: list[TraceResult], record: bool) -> TraceResult:
+    """One :class:`TraceResult` from the results of consecutive chunks of rays."""
+    fields = ("hit", "t", "axis", "voxel", "requests", "steps", "descents", "pops", "restarts",
+              "max_level", "max_stack")
+    result = TraceResult(*(np.concatenate([getattr(p, f) for p in parts]) for f in fields))
+    if record:
+        first = np.cumsum([0] + [len(p.hit) for p in parts[:-1]])
+        result.trace_ray = np.concatenate([p.trace_ray + off for p, off in zip(parts, first)])
+        result.trace_addr = np.concatenate([p.trace_addr for p in parts])
+        result.trace_level = np.concatenate([p.trace_level for p in parts])
+    return result
+
+
+def _trace_numpy(tree: Octree, origin: np.ndarray, direction: np.ndarray, root_table: int,
+                 stack_depth: int, fixed: bool, limit: int, record: bool) -> TraceResult:
+    """:func:`trace` on the lockstep numpy traversal, ray setup included."""
     hits_root, dmask, rt0, rt1, shift, scale = setup_rays(origin, direction)
     n = len(hits_root)
     out = {name: np.zeros(n, dtype=np.int32) for name in
@@ -393,12 +445,8 @@ def _trace_numba(tree: Octree, origin: np.ndarray, direction: np.ndarray, root_t
     """:func:`trace` on the compiled kernel (fixed point), ray setup included."""
     from .traverse_jit import trace_fixed
 
-    o = np.asarray(origin, dtype=np.float64).reshape(-1, 3)
-    d = np.asarray(direction, dtype=np.float64).reshape(-1, 3)
-    if len(o) != len(d):
-        o, d = np.broadcast_arrays(o, d)
     (bad, hit, t, axis, code, requests, steps, descents, pops, restarts, max_level, max_stack,
-     rec_ray, rec_addr, rec_lvl) = trace_fixed(tree.words, o, d, root_table, stack_depth, limit, record)
+     rec_ray, rec_addr, rec_lvl) = trace_fixed(tree.words, origin, direction, root_table, stack_depth, limit, record)
     if bad:
         raise ValueError(f"{bad} rays have a non-finite origin or a zero/non-finite direction")
     n = len(hit)

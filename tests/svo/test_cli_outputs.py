@@ -1,4 +1,4 @@
-"""svo render's image outputs: PNG only, existing folders, checked before tracing."""
+"""svo outputs: checked before any work, missing folders made; render writes PNG only."""
 
 import pytest
 from click.testing import CliRunner
@@ -29,7 +29,6 @@ def test_render_writes_png_and_cost(svo, tmp_path):
 @pytest.mark.parametrize(("args", "why"), [
     (["-o", "{t}/x.jpg"], "unknown image type '.jpg'"),
     (["-o", "{t}/a.png", "--cost", "{t}/c"], "unknown image type '(no extension)'"),
-    (["-o", "{t}/nope/a.png"], "does not exist"),
     (["-o", "{t}/a.png", "--with-program", "programs/sphere.asm", "--cost", "{t}/c.gif"], "unknown image type '.gif'"),
 ])
 def test_bad_outputs_are_refused_before_rendering(svo, tmp_path, args, why):
@@ -42,3 +41,20 @@ def test_sizes_use_the_shared_limit(svo, tmp_path):
     for cmd in ("render", "sweep"):
         r = _run(cmd, svo, "-o", tmp_path / "x.png", "--size", "100000x1")
         assert r.exit_code == 2 and "1..8192" in r.output, r.output
+
+
+def test_missing_folders_are_made(svo, tmp_path):
+    r = _run("render", svo, "-o", tmp_path / "a" / "b" / "x.png", "--size", "12x8")
+    assert r.exit_code == 0, r.output
+    assert Image.open(tmp_path / "a" / "b" / "x.png").size == (12, 8)
+
+
+@pytest.mark.parametrize("cmd", [
+    ["model", "sphere"], ["build", "{svo}"], ["render", "{svo}"], ["sweep", "{svo}"]])
+def test_an_output_that_cannot_be_written_is_refused_first(svo, tmp_path, cmd):
+    (tmp_path / "file").write_text("not a folder")
+    name = {"model": "m.obj", "build": "m.svo", "render": "m.png", "sweep": "m"}[cmd[0]]
+    args = [a.format(svo=svo) for a in cmd] + ["-o", tmp_path / "file" / name]
+    r = _run(*args, "--size", "12x8") if cmd[0] in ("render", "sweep") else _run(*args)
+    assert r.exit_code == 1 and "cannot write" in r.output and "file" in r.output, r.output
+    assert [p.name for p in tmp_path.iterdir()] == ["file"]

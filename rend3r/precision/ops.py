@@ -41,6 +41,7 @@ from . import exact
 from .formats import FloatFormat, Tininess
 from .rounding import midpoints, round_to_format
 
+_ABS = np.uint64((1 << 63) - 1)
 Side = Callable[[np.ndarray], np.ndarray]  # lanes (bool mask) -> sign(exact - r) there
 
 
@@ -48,9 +49,10 @@ def read(fmt: FloatFormat, a: np.ndarray | float) -> np.ndarray:
     """Operands as the format's units read them: float64, subnormals as signed zero with ftz."""
     v = np.asarray(a, dtype=np.float64)
     if fmt.ftz:
-        mag = np.abs(v)
-        if mag.size and mag.min() < fmt.min_normal:
-            v = np.where(mag < fmt.min_normal, np.copysign(0.0, v), v)
+        wrapped = (v.view(np.uint64) & _ABS) - np.uint64(1)  # zero wraps to the top
+        limit = np.float64(fmt.min_normal).view(np.uint64) - np.uint64(1)
+        if v.size and wrapped.min() < limit:
+            v = np.where(wrapped < limit, np.copysign(0.0, v), v)
     return v
 
 

@@ -89,7 +89,7 @@ def round_to_format(fmt: FloatFormat, x: np.ndarray | float, *, tininess: Tinine
     g = _grid(fmt.exp_bits, fmt.frac_bits)
     direction = None if toward is None else _signed_toward(bits, np.broadcast_to(toward, shape).reshape(-1))
     r = _round_normal(g, mag, direction)
-    small = np.flatnonzero(mag < g.min_normal) if mag.size and mag.min() < g.min_normal else None
+    small = _nonzero_below(mag, g.min_normal)
     if small is not None:  # the format's subnormal range, lane by lane
         m = mag[small]
         rs = _round_small(g, m, None if direction is None else direction[small])
@@ -104,6 +104,15 @@ def round_to_format(fmt: FloatFormat, x: np.ndarray | float, *, tininess: Tinine
         r[nan] = (mag[nan] & g.nan_keep) | _QUIET
     r |= bits & _SIGN
     return r.view(np.float64).reshape(shape)
+
+
+def _nonzero_below(mag: np.ndarray, limit: np.uint64) -> np.ndarray | None:
+    """Indices of the magnitudes in (0, limit), or None when there are none (a common case
+    checked in one pass: zero wraps to the top when one is subtracted)."""
+    wrapped = mag - _ONE
+    if not mag.size or wrapped.min() >= limit - _ONE:
+        return None
+    return np.flatnonzero(wrapped < limit - _ONE)
 
 
 def _tie_bits(tie: np.ndarray, direction: np.ndarray | None) -> np.ndarray:
@@ -150,8 +159,8 @@ def midpoints(fmt: FloatFormat, x: np.ndarray) -> np.ndarray:
     else:
         low = mag & np.uint64((1 << g.drop) - 1)
         on_half = (low == np.uint64(1 << (g.drop - 1))) & (mag < _INF)
-    if mag.size and mag.min() < g.min_normal:
-        small = np.flatnonzero(mag < g.min_normal)
+    small = _nonzero_below(mag, g.min_normal)
+    if small is not None:
         m = mag[small]
         drop = _small_drops(g, m)
         half = (_ONE << drop) >> _ONE

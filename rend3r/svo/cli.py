@@ -137,6 +137,7 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
     from .voxelize import voxelize_codes
 
     budget = max_memory or default_budget()
+    bars = partial(Progress, quiet=quiet)
     start = time.perf_counter()
     with Outputs() as out:
         for path in (output, binvox_out):
@@ -164,8 +165,7 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
                                   "voxels per axis)")
             verts, faces = read_mesh(mesh)
             try:
-                codes, lo, h = voxelize_codes(verts, faces, depth, solid, budget,
-                                              partial(Progress, quiet=quiet))
+                codes, lo, h = voxelize_codes(verts, faces, depth, solid, budget, bars)
             except Rend3rError as exc:
                 raise Rend3rError(f"{mesh}: {exc}") from None
             del verts, faces
@@ -174,7 +174,7 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
         if binvox_out:
             out.write(binvox_out, encode_binvox(morton_decode(codes, depth), 1 << depth, tuple(lo),
                                                 h * (1 << depth)))
-        tree = build_octree_codes(codes, depth, ptr_bits)
+        tree = build_octree_codes(codes, depth, ptr_bits, bars)
         del codes
         hi = lo + h * (1 << depth)
         bounds = tuple(float(x) for x in lo) + tuple(float(x) for x in hi)

@@ -22,11 +22,13 @@ words from its node and every near pointer points forward.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import Rend3rError
+from ..progress import ProgressFactory, hidden
 
 PTR_SHIFT = 17
 FAR_BIT = 1 << 16
@@ -104,8 +106,10 @@ class Octree:
         return far
 
 
-def _level_nodes(codes: np.ndarray, depth: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """Per level L = 0..depth-1: (node keys, valid masks, index of first child node)."""
+def _level_nodes(codes: np.ndarray, depth: int, on_level: Callable[[int], None] = lambda n: None
+                 ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per level L = 0..depth-1: (node keys, valid masks, index of first child node);
+    ``on_level(1)`` after each level."""
     levels = []
     child_codes = codes
     for _ in range(depth):
@@ -116,6 +120,7 @@ def _level_nodes(codes: np.ndarray, depth: int) -> list[tuple[np.ndarray, np.nda
         valid = np.bitwise_or.reduceat(bits, first) if len(first) else np.zeros(0, np.uint8)
         levels.append((keys, valid.astype(np.int64), first))
         child_codes = keys
+        on_level(1)
     return levels[::-1]
 
 
@@ -138,15 +143,24 @@ def build_octree(coords: np.ndarray, depth: int, ptr_bits: int = DEFAULT_PTR_BIT
     return build_octree_codes(codes[np.r_[True, codes[1:] != codes[:-1]]], depth, ptr_bits)
 
 
-def build_octree_codes(codes: np.ndarray, depth: int, ptr_bits: int = DEFAULT_PTR_BITS) -> Octree:
-    """:func:`build_octree` from sorted unique Morton codes (:func:`morton_encode`)."""
+def build_octree_codes(codes: np.ndarray, depth: int, ptr_bits: int = DEFAULT_PTR_BITS,
+                       progress: ProgressFactory = hidden) -> Octree:
+    """:func:`build_octree` from sorted unique Morton codes (:func:`morton_encode`).
+
+    ``progress``'s bar counts levels twice: deriving the nodes, then writing the words.
+    """
+    with progress(2 * depth, "building octree") as bar:
+        return _build(codes, depth, ptr_bits, bar.advance)
+
+
+def _build(codes: np.ndarray, depth: int, ptr_bits: int, advance: Callable[[int], None]) -> Octree:
     if not 1 <= depth <= MAX_DEPTH:
         raise Rend3rError(f"octree depth must be 1..{MAX_DEPTH}, got {depth}")
     if not 4 <= ptr_bits <= 15:
         raise Rend3rError(f"pointer width must be 4..15 bits, got {ptr_bits}")
     if len(codes) == 0:
         raise Rend3rError("no voxels to build an octree from")
-    levels = _level_nodes(codes, depth)
+    levels = _level_nodes(codes, depth, advance)
     n_levels = len(levels)
     counts = [len(k) for k, _, _ in levels]
     # Per level L >= 1: parent index of each node and its rank inside the parent's table.
@@ -195,6 +209,7 @@ def build_octree_codes(codes: np.ndarray, depth: int, ptr_bits: int = DEFAULT_PT
             if np.any(is_far):
                 words[slot_addr[is_far]] = rel[is_far]
         words[addr[lvl]] = word
+        advance(1)
     if words.max() >= 1 << 32:
         raise Rend3rError("octree too large: a far pointer exceeds 32 bits")
     return Octree(words.astype(np.uint32), depth, ptr_bits)

@@ -25,7 +25,7 @@ from rend3r.svo.interrupt import ctrl_c_ignored, off_main_thread
 STARTUP = 20.0  # seconds allowed to reach the stage (imports on a loaded 2-core machine)
 STOP = 2.0  # seconds allowed from Ctrl-C to exit
 #: one state of a progress bar (click's), as a terminal receives it
-BAR = re.compile(r"(\x1b\[\?25[lh])*(tracing|voxelising|simulating)  \[[#-]*\]\s+\d+%(\s+\d\d:\d\d:\d\d)?\s*"
+BAR = re.compile(r"(\x1b\[\?25[lh])*(tracing|voxelising|building octree|simulating)  \[[#-]*\]\s+\d+%(\s+\d\d:\d\d:\d\d)?\s*"
                  r"(\x1b\[\?25[lh])*")
 
 

@@ -17,7 +17,7 @@ def test_every_registered_command_loads_and_has_an_example():
 
 #: The commands that write files, and what their -o/--output names.
 WRITERS = {"asm": "FILE|STEM", "disasm": "FILE", "emulate": "PATTERN", "send": "FILE", "device": "DIR",
-           "render-all": "DIR"}
+           "render-all": "DIR", "compare": "FILE"}
 
 
 def test_every_command_that_writes_takes_dash_o_with_a_metavar_saying_what():

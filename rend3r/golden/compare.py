@@ -80,15 +80,16 @@ def _psnr(ctx: click.Context, param: click.Parameter, value: float | None) -> fl
 @click.command("compare")
 @click.argument("a", type=click.Path(path_type=Path, dir_okay=False))
 @click.argument("b", type=click.Path(path_type=Path, dir_okay=False))
-@click.option("--diff", "diff_path", type=click.Path(path_type=Path), metavar="FILE",
+@click.option("-o", "--output", "diff_path", type=click.Path(path_type=Path), metavar="FILE",
               help="Write a diff PNG (changed pixels magenta); missing folders are made.")
+@click.option("--diff", "old_diff_path", type=click.Path(path_type=Path), hidden=True)  # -o's older spelling
 @click.option("--max-channel", type=click.IntRange(0, 255), default=0, show_default=True, metavar="N", help="Largest allowed channel difference (RGB888).")
 @click.option("--max-share", type=click.FloatRange(0.0, 1.0), default=None, metavar="SHARE", help="Largest allowed share of differing pixels (0..1).")
 @click.option("--min-psnr", type=float, default=None, callback=_psnr, metavar="DB", help="Smallest allowed PSNR in dB (inf: identical).")
 @click.option("--size", type=SIZE, default=None, help="Size of raw RGB565 inputs (default 512x384).")
 def compare_command(
-    a: Path, b: Path, diff_path: Path | None, max_channel: int, max_share: float | None, min_psnr: float | None,
-    size: tuple[int, int] | None
+    a: Path, b: Path, diff_path: Path | None, old_diff_path: Path | None, max_channel: int, max_share: float | None,
+    min_psnr: float | None, size: tuple[int, int] | None
 ) -> None:
     """Compare image B against reference A and print the metrics.
 
@@ -98,8 +99,11 @@ def compare_command(
 
     \b
     Example:
-      rend3r compare programs/golden/sphere.png out/sphere.png --max-channel 8 --diff d.png
+      rend3r compare programs/golden/sphere.png out/sphere.png --max-channel 8 -o out/diff.png
     """
+    if diff_path is not None and old_diff_path is not None:
+        raise click.UsageError("-o and --diff name the same output: give one")
+    diff_path = diff_path or old_diff_path
     try:
         m = compare_files(a, b, diff_path, size)
     except Rend3rError as exc:

@@ -36,7 +36,7 @@ def test_difference_beyond_tolerance_exit_1_and_diff(tmp_path: Path) -> None:
     other[2, 3] = (0, 40, 0)
     a, b = _png(tmp_path / "a.png", rgb), _png(tmp_path / "b.png", other)
     diff = tmp_path / "d.png"
-    r = CliRunner().invoke(main, ["compare", str(a), str(b), "--diff", str(diff)])
+    r = CliRunner().invoke(main, ["compare", str(a), str(b), "-o", str(diff)])
     assert r.exit_code == 1, r.output
     assert "max channel difference 40" in r.output and "NOT within tolerance" in r.output
     d = np.asarray(Image.open(diff))
@@ -101,16 +101,24 @@ def test_diff_path_is_checked_before_comparing(tmp_path: Path) -> None:
     for diff, why in ((tmp_path / "plain" / "d.png", f"cannot write {tmp_path / 'plain' / 'd.png'}: "
                                                      f"{tmp_path / 'plain'} is not a folder"),
                       (tmp_path / "d.txt", "unknown image type")):
-        r = CliRunner().invoke(main, ["compare", str(a), str(a), "--diff", str(diff), "--size", "1x1"])
+        r = CliRunner().invoke(main, ["compare", str(a), str(a), "-o", str(diff), "--size", "1x1"])
         assert r.exit_code == 2 and why in r.output, r.output
         assert not diff.exists()
 
 
-def test_diff_folders_are_made(tmp_path: Path) -> None:
+@pytest.mark.parametrize("option", ["-o", "--output", "--diff"])
+def test_diff_folders_are_made(tmp_path: Path, option: str) -> None:
     a = _png(tmp_path / "a.png", np.zeros((2, 2, 3), np.uint8))
-    r = CliRunner().invoke(main, ["compare", str(a), str(a), "--diff", str(tmp_path / "x" / "y" / "d.png")])
+    r = CliRunner().invoke(main, ["compare", str(a), str(a), option, str(tmp_path / "x" / "y" / "d.png")])
     assert r.exit_code == 0, r.output
     assert Image.open(tmp_path / "x" / "y" / "d.png").size == (2, 2)
+
+
+def test_two_spellings_of_the_diff_are_a_usage_error(tmp_path: Path) -> None:
+    a = _png(tmp_path / "a.png", np.zeros((2, 2, 3), np.uint8))
+    r = CliRunner().invoke(main, ["compare", str(a), str(a), "-o", str(tmp_path / "d.png"), "--diff",
+                                  str(tmp_path / "e.png")])
+    assert r.exit_code == 2 and "-o and --diff name the same output" in r.output
 
 
 @pytest.mark.parametrize(("pos", "value"), [(11, 0), (36, 0), (20, 0xFF)])

@@ -42,7 +42,7 @@ from .formats import FloatFormat, Tininess
 from .rounding import midpoints, round_to_format
 
 _ABS = np.uint64((1 << 63) - 1)
-Side = Callable[[np.ndarray], np.ndarray]  # lanes (bool mask) -> sign(exact - r) there
+Side = Callable[[np.ndarray], np.ndarray]  # flat lane indices -> sign(exact - r) there
 
 
 def read(fmt: FloatFormat, a: np.ndarray | float) -> np.ndarray:
@@ -61,16 +61,21 @@ def _double_rounding_possible(fmt: FloatFormat) -> bool:
 
 
 def _finish(fmt: FloatFormat, r: np.ndarray, side: Side, tininess: Tininess) -> np.ndarray:
-    """Round the float64 result ``r`` to ``fmt`` as the exact result would be rounded."""
+    """Round the float64 result ``r`` to ``fmt`` as the exact result would be rounded: every
+    lane at once, then again, knowing the exact side, the few lanes where that matters."""
+    out = round_to_format(fmt, r, tininess=tininess)
     need = midpoints(fmt, r) if _double_rounding_possible(fmt) else None
     if fmt.ftz and tininess == "before":
         at_min = np.abs(r) == fmt.min_normal
         need = at_min if need is None else need | at_min
-    toward = None
     if need is not None and need.any():
-        toward = np.zeros(r.shape, dtype=np.int8)
-        toward[need] = side(need)
-    return round_to_format(fmt, r, tininess=tininess, toward=toward)
+        lanes = np.flatnonzero(need)
+        out.reshape(-1)[lanes] = round_to_format(fmt, _at(r, lanes), tininess=tininess, toward=side(lanes))
+    return out
+
+
+def _at(v: np.ndarray, lanes: np.ndarray) -> np.ndarray:
+    return v.reshape(-1)[lanes]
 
 
 def _operands(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
@@ -84,7 +89,7 @@ def add(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float, *,
     x, y = _operands(fmt, a, b)
     with np.errstate(all="ignore"):
         r = np.add(x, y)
-        return _finish(fmt, r, lambda m: exact.sum_side(x[m], y[m], r[m]), tininess)
+        return _finish(fmt, r, lambda i: exact.sum_side(_at(x, i), _at(y, i), _at(r, i)), tininess)
 
 
 def sub(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float, *,
@@ -99,7 +104,7 @@ def mul(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float, *,
     x, y = _operands(fmt, a, b)
     with np.errstate(all="ignore"):
         r = np.multiply(x, y)
-        return _finish(fmt, r, lambda m: exact.product_side(x[m], y[m], r[m]), tininess)
+        return _finish(fmt, r, lambda i: exact.product_side(_at(x, i), _at(y, i), _at(r, i)), tininess)
 
 
 def div(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float, *,
@@ -108,7 +113,7 @@ def div(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float, *,
     x, y = _operands(fmt, a, b)
     with np.errstate(all="ignore"):
         r = np.divide(x, y)
-        return _finish(fmt, r, lambda m: exact.quotient_side(x[m], y[m], r[m]), tininess)
+        return _finish(fmt, r, lambda i: exact.quotient_side(_at(x, i), _at(y, i), _at(r, i)), tininess)
 
 
 def sqrt(fmt: FloatFormat, a: np.ndarray | float, *, tininess: Tininess = "after") -> np.ndarray:
@@ -116,4 +121,4 @@ def sqrt(fmt: FloatFormat, a: np.ndarray | float, *, tininess: Tininess = "after
     x = read(fmt, a)
     with np.errstate(all="ignore"):
         r = np.sqrt(x)
-        return _finish(fmt, r, lambda m: exact.sqrt_side(x[m], r[m]), tininess)
+        return _finish(fmt, r, lambda i: exact.sqrt_side(_at(x, i), _at(r, i)), tininess)

@@ -72,8 +72,8 @@ def _finite(lo: float, hi: float):
     return check
 
 
-@svo_group.command("model")
-@click.argument("name", type=click.Choice(["sphere", "torus", "folded"]))
+@svo_group.command("model", short_help="Write a procedural mesh: sphere, torus or folded.")
+@click.argument("name", type=click.Choice(["sphere", "torus", "folded"]), metavar="NAME")
 @click.option("-o", "--output", required=True, metavar="FILE",
               help="Mesh file to write: .obj, .ply or .stl (missing folders are made).")
 @click.option("--detail", type=click.IntRange(4, 2048), default=None, metavar="N",
@@ -81,7 +81,7 @@ def _finite(lo: float, hi: float):
 @click.option("--ascii", "ascii_", is_flag=True, help="ASCII PLY/STL instead of binary.")
 @quiet_option
 def model_cmd(name: str, output: str, detail: int | None, ascii_: bool, quiet: bool) -> None:
-    """Write a procedural mesh NAME (no downloads).
+    """Write the procedural mesh NAME: sphere, torus or folded (no downloads).
 
     \b
     Example:
@@ -104,7 +104,7 @@ def model_cmd(name: str, output: str, detail: int | None, ascii_: bool, quiet: b
 @click.option("-o", "--output", required=True, metavar="FILE",
               help=".svo file to write (missing folders are made).")
 @click.option("--depth", type=click.IntRange(1, 16), default=None, metavar="N",
-              help="Octree levels, 2**N voxels per axis (1..16). Required for a mesh; a binvox "
+              help="Octree levels, 2**N voxels per axis. Required for a mesh; a binvox "
                    "grid has its own (given, it must match).")
 @click.option("--solid", is_flag=True, help="Fill the inside of closed meshes.")
 @click.option("--ptr-bits", type=click.IntRange(4, 15), default=15, show_default=True, metavar="N",
@@ -125,7 +125,7 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
     Example:
       rend3r svo build out/folded.ply -o out/folded.svo --depth 10
       rend3r svo build out/torus.obj -o out/torus.svo --depth 8 --solid --binvox out/torus.binvox
-      rend3r svo build chair.binvox -o out/chair.svo
+      rend3r svo build out/torus.binvox -o out/torus2.svo
     """
     import numpy as np
 

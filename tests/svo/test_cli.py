@@ -57,3 +57,16 @@ def test_errors(tmp_path):
         assert r.exit_code == 1 and "rend3r: error:" in r.output and "Traceback" not in r.output
     r = CliRunner().invoke(main, ["svo", "render", str(bad), "-o", "x.png", "--size", "0x5"])
     assert r.exit_code == 2
+
+
+def test_help_has_examples_and_whole_summaries():
+    listing = _run("--help").output
+    for name in ("model", "build", "render", "sweep"):
+        row = next(line for line in listing.splitlines() if line.strip().startswith(name + " "))
+        assert not row.endswith("..."), row
+        page = _run(name, "--help").output
+        assert "Example:\n" in page and f"rend3r svo {name} " in page, name
+        assert "-q, --quiet" in page, name
+        assert ("-o, --output STEM" if name == "sweep" else "-o, --output FILE") in page, name
+    assert "Required for a mesh" in _run("build", "--help").output
+    assert "Writes STEM.csv and STEM.md" in _run("sweep", "--help").output

@@ -18,7 +18,7 @@ midpoint of the format's grid the tie then goes that way instead of to even.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 
@@ -33,7 +33,7 @@ _WIDEST = 53  # bits dropped when a value lies in [q/2, q), q the smallest subno
 
 
 def _bits(value: float) -> np.uint64:
-    return np.array(value, dtype=np.float64).view(np.uint64)[()]
+    return np.float64(value).view(np.uint64)
 
 
 @dataclass(frozen=True)
@@ -49,7 +49,7 @@ class _Grid:
     nan_keep: np.uint64  # the payload bits a NaN keeps
 
 
-@lru_cache(maxsize=None)
+@cache
 def _grid(exp_bits: int, frac_bits: int) -> _Grid:
     fmt = FloatFormat(exp_bits, frac_bits)
     drop = 52 - frac_bits

@@ -58,7 +58,7 @@ def test_unknown_operator() -> None:
 
 def test_the_table_in_the_docs_is_the_model() -> None:
     doc = (Path(__file__).parents[2] / "docs" / "precision.md").read_text()
-    rows = re.findall(r"^\| (\w+) \| ((?:\d+ / \d+ / \d+ / \d+ \| ?)+)$", doc, flags=re.M)
+    rows = re.findall(r"^\| (\w+) \| ((?:\d+ / \d+ / \d+ / \d+ \| ?)+)$", doc, flags=re.MULTILINE)
     assert len(rows) >= 8
     ops = [op for op in OPERATORS if op != "sub"]
     for name, cells in rows:

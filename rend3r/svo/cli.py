@@ -16,6 +16,7 @@ import click
 
 from ..cliutil import SIZE
 from ..errors import Rend3rError
+from ..fileio import Outputs
 from ..progress import Progress, quiet_option
 
 _EPILOG = """\b
@@ -39,7 +40,7 @@ def svo_group(ctx: click.Context) -> None:
     ctx.with_resource(np.errstate(all="ignore"))
 
 
-def _commit(out, summary: str, quiet: bool) -> None:
+def _commit(out: Outputs, summary: str, quiet: bool) -> None:
     """Move the staged outputs into place and print the summary, with Ctrl-C ignored: from
     here on the run completes (exit 0, every output written) instead of stopping half-way."""
     from .interrupt import ctrl_c_ignored
@@ -88,7 +89,6 @@ def model_cmd(name: str, output: str, detail: int | None, ascii_: bool, quiet: b
       rend3r svo model torus -o out/torus.obj --detail 64
       rend3r svo model folded -o out/folded.ply
     """
-    from ..fileio import Outputs
     from .mesh_io import encode_mesh
     from .models import make_model
 
@@ -129,7 +129,6 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
     """
     import numpy as np
 
-    from ..fileio import Outputs
     from .budget import FILL_BYTES, check_budget, default_budget, max_voxels
     from .fileformat import SvoModel, encode_svo
     from .mesh_io import encode_binvox, read_binvox, read_mesh
@@ -263,7 +262,6 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
     from PIL import Image
 
     from ..emu.image import check_output
-    from ..fileio import Outputs
     from .camera import model_matrix, orbit_camera
     from .fileformat import read_svo
     from .render import cost_image, render
@@ -338,7 +336,6 @@ def sweep_cmd(model: str, output: str, size, views: int, jobs: int, kernel: str,
       rend3r svo sweep out/folded.svo -o out/sweep
       rend3r svo sweep out/folded.svo -o out/sweep4 --views 4 --jobs 2
     """
-    from ..fileio import Outputs
     from .fileformat import read_svo
     from .sweep import run_sweep, thesis_points, to_csv, to_markdown
 

@@ -70,3 +70,15 @@ def test_help_has_examples_and_whole_summaries():
         assert ("-o, --output STEM" if name == "sweep" else "-o, --output FILE") in page, name
     assert "Required for a mesh" in _run("build", "--help").output
     assert "Writes STEM.csv and STEM.md" in _run("sweep", "--help").output
+
+
+def test_quiet_drops_the_summary_but_not_the_stats(tmp_path):
+    mesh, svo = str(tmp_path / "s.obj"), str(tmp_path / "s.svo")
+    r = _run("model", "sphere", "-o", mesh, "--detail", "8", "-q")
+    assert r.exit_code == 0 and r.output == ""
+    r = _run("build", mesh, "-o", svo, "--depth", "4", "--quiet")
+    assert r.exit_code == 0 and r.output == "" and read_svo(svo).tree.depth == 4
+    r = _run("render", svo, "-o", str(tmp_path / "s.png"), "--size", "8x6", "-q", "--kernel", "numpy")
+    assert r.exit_code == 0 and r.output == ""
+    r = _run("render", svo, "-o", str(tmp_path / "s.png"), "--size", "8x6", "-q", "--kernel", "numpy", "--stats")
+    assert r.exit_code == 0 and '"rays": 48' in r.output

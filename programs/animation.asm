@@ -4,8 +4,8 @@
 ;         animation loops. A green sphere orbits a fixed red one in eight steps of 45
 ;         degrees in the x-z plane (positions written out below); the red sphere's shadow
 ;         does not change, but the green sphere passes in front of and behind it.
-; Run:    rend3r emulate programs/animation.asm --frames 8 -o 'anim_{n:03}.png'
-;         (or --gif anim.gif)
+; Run:    rend3r emulate programs/animation.asm --frames 8 -o 'out/anim_{n:03}.png'
+;         (or --gif out/anim.gif)
 ; Look:   frame 0: the small green sphere to the right of the red one; frame 2: in front
 ;         of it, larger, covering all but a thin red rim; frame 4: to the left; frame 6:
 ;         hidden behind it. In fp16 (the default) the green sphere's edge is ragged where

@@ -6,7 +6,7 @@
 ;         narrowed to 0.2 of the default in both axes; the near clip plane is 4.5 units
 ;         ahead (it cuts into the nearest sphere) and the far clip 13, so the spheres
 ;         beyond 13 units are not drawn.
-; Run:    rend3r emulate programs/camera.asm -o camera.png
+; Run:    rend3r emulate programs/camera.asm -o out/camera.png
 ; Look:   orange-to-yellow spheres in a row from the lower left towards the centre. The
 ;         nearest, cut open by the near clip plane, shows only a thin lit crescent along
 ;         its upper and right edge (its inside is black); the next two are whole and

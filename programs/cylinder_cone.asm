@@ -3,7 +3,7 @@
 ; Shows:  shape type 2 (cylinder x^2 + y^2 = 1, infinite along its z axis) and type 3
 ;         (double cone x^2 + y^2 = z^2). Both are turned 90 degrees about x so their axes
 ;         stand vertical on screen: quaternion (cos 45, sin 45, 0, 0).
-; Run:    rend3r emulate programs/cylinder_cone.asm -o cylinder_cone.png
+; Run:    rend3r emulate programs/cylinder_cone.asm -o out/cylinder_cone.png
 ; Look:   on the left a green vertical band (the cylinder, radius 0.6) running off the top
 ;         and bottom of the screen; on the right an orange hourglass (the double cone,
 ;         apex at the centre height, opening 1:2). Both lit from the right. In fp16 the

@@ -6,7 +6,7 @@
 ;         shadow ray can start inside the red sphere and report a shadow (acne), and the
 ;         nearest-hit comparison of two almost equal squared distances picks the red
 ;         sphere at some pixels (z-fighting).
-; Run:    rend3r emulate programs/fp16_acne.asm -o fp16_acne.png
+; Run:    rend3r emulate programs/fp16_acne.asm -o out/fp16_acne.png
 ; Look:   fp16: a green sphere covered in concentric black rings and specks around a
 ;         black spot at its centre (a moire of rounding): where the red sphere wins it is
 ;         black, because the green shell around it shadows it; fp64: smooth green.

@@ -5,7 +5,7 @@
 ;         grow like S^2 while their difference stays of order 1, so float16's 11-bit
 ;         significand leaves few or no correct bits. Left: a sphere at S = 16; right: one
 ;         at S = 32. A very narrow field of view (0.03 of the default) makes them large.
-; Run:    rend3r emulate programs/fp16_cancel.asm -o fp16_cancel.png
+; Run:    rend3r emulate programs/fp16_cancel.asm -o out/fp16_cancel.png
 ; Look:   fp16: each sphere broken into vertical crescent-shaped slices with black gaps
 ;         between them, each slice shaded flat, the right (blue) sphere far worse than the
 ;         left (orange); fp32/fp64: two smooth shaded spheres.

@@ -6,7 +6,7 @@
 ;         (narrow field of view, 0.15 of the default; the near clip at 100 makes the
 ;         unnormalised ray directions 100 long, so nothing underflows, see
 ;         fp16_underflow.asm).
-; Run:    rend3r emulate programs/fp16_distance.asm -o fp16_distance.png
+; Run:    rend3r emulate programs/fp16_distance.asm -o out/fp16_distance.png
 ;         (compare --precision fp32, which draws all three)
 ; Look:   fp16: the left sphere whole, with a ragged top edge and faint seams where its
 ;         shading steps; of the middle one only a central disc (the part nearer than 256

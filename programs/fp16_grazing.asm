@@ -9,7 +9,7 @@
 ;         Light 0 travels exactly along the cylinder's axis, parallel to its surface
 ;         (n.l = 0, adds nothing to the cylinder); light 1 is a point light between
 ;         the two shapes.
-; Run:    rend3r emulate programs/fp16_grazing.asm -o fp16_grazing.png
+; Run:    rend3r emulate programs/fp16_grazing.asm -o out/fp16_grazing.png
 ; Look:   a lavender pipe running from the lower right corner into the centre; an
 ;         orange hourglass pinched to a point at the upper left, its far nappe a disc
 ;         around the centre. In fp16 that disc's right and lower rim, more than 256 units

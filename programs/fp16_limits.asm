@@ -8,7 +8,7 @@
 ;         infinite along x); a sphere with a non-unit quaternion (2, 0, 0, 0); and a
 ;         background sphere of radius 30000 whose centre is 60000 units away (its
 ;         distance overflows in float16).
-; Run:    rend3r emulate programs/fp16_limits.asm -o fp16_limits.png
+; Run:    rend3r emulate programs/fp16_limits.asm -o out/fp16_limits.png
 ;         (compare --precision fp64 and --subnormals ieee)
 ; Look:   fp16: a red sphere (the zero quaternion reads as no rotation) above a
 ;         horizontal cyan bar across the screen; the non-unit-quaternion sphere is lost

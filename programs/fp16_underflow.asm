@@ -7,7 +7,7 @@
 ;         |x| or |y| < 0.156: with --subnormals ftz (the device's vendor IP) they become 0,
 ;         the quadratic's a shrinks and the sphere grows along those bands. With
 ;         --subnormals ieee the subnormals keep enough bits and the disc stays round.
-; Run:    rend3r emulate programs/fp16_underflow.asm -o fp16_underflow.png
+; Run:    rend3r emulate programs/fp16_underflow.asm -o out/fp16_underflow.png
 ;         (compare --subnormals ieee and --precision fp64)
 ; Look:   fp16 ftz: not a disc but a purple square with stepped corners, two overlapping
 ;         rectangles (a cross of wider bands through the centre): where both squared

@@ -6,9 +6,10 @@
 ;         --with-program` places a voxel model. The merge keeps, per pixel, whichever of
 ;         the model and the program's shapes is nearer, so the model hides part of the
 ;         blue sphere behind it.
-; Run:    rend3r emulate programs/hybrid.asm -o hybrid_set.png
-;         rend3r svo model torus -o torus.ply && rend3r svo build torus.ply -o torus.svo --depth 7
-;         rend3r svo render torus.svo --with-program programs/hybrid.asm --place 0,0,-4,1 -o hybrid.png
+; Run:    rend3r emulate programs/hybrid.asm -o out/hybrid_set.png
+;         rend3r svo model torus -o out/torus.ply
+;         rend3r svo build out/torus.ply -o out/torus.svo --depth 7
+;         rend3r svo render out/torus.svo --with-program programs/hybrid.asm --place 0,0,-4,1 -o out/hybrid.png
 ; Look:   alone: a grey floor curving away below a black sky, a blue sphere left of
 ;         centre and a smaller red one at the front right, each with its shadow on the
 ;         floor (in fp16 the red sphere's right edge is ragged); merged: the torus stands

@@ -7,7 +7,7 @@
 ;         keeps the nearer surface per pixel. A triangle floor and an orange pyramid of
 ;         four triangles; a red sphere that pierces the pyramid's left face and a blue
 ;         one in front of it at the right. Triangles are flat-shaded and take no shadows.
-; Run:    rend3r emulate programs/hybrid_mix.asm --mode hybrid -o hybrid_mix.png
+; Run:    rend3r emulate programs/hybrid_mix.asm --mode hybrid -o out/hybrid_mix.png
 ; Look:   a grey triangle floor ending in a straight far edge, the orange front face of
 ;         the pyramid, the red sphere half hidden behind it where it pierces the face, the
 ;         small blue sphere in front at the right (in fp16 its lower edge is ragged).

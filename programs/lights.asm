@@ -4,7 +4,7 @@
 ;         blue directional light from the right, a green point light above and in front
 ;         of the spheres at half intensity, and light 3 switched off (src 0) with full
 ;         white intensity to show that an off light adds nothing.
-; Run:    rend3r emulate programs/lights.asm -o lights.png
+; Run:    rend3r emulate programs/lights.asm -o out/lights.png
 ; Look:   three white spheres in a row, each red on its left and blue on its right,
 ;         purple between; the green point light tints their tops (teal over blue, yellow
 ;         over red). The middle sphere shades its neighbours' inner flanks from the side

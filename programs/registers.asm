@@ -5,7 +5,7 @@
 ;         mnemonics, every material value (0..3; materials do not change the image), a
 ;         raw-bits value (0h3c00 = 1.0) and a named constant. It describes exactly the
 ;         scene of sphere.asm, so it must render to the same frame buffer.
-; Run:    rend3r emulate programs/registers.asm -o registers.png
+; Run:    rend3r emulate programs/registers.asm -o out/registers.png
 ; Look:   identical to sphere.asm: a red disc lit from the upper right.
 ; frames: 1
 

@@ -3,7 +3,7 @@
 ; Shows:  shadow rays. A yellow sphere (radius 0.5) floats between the light and a big
 ;         blue sphere (radius 2); the light travels along (-0.4, -0.4, -1), which carries
 ;         the small sphere's centre onto the big sphere's centre.
-; Run:    rend3r emulate programs/shadow.asm -o shadow.png
+; Run:    rend3r emulate programs/shadow.asm -o out/shadow.png
 ; Look:   a big blue disc lit from the upper right with a round black shadow on its face,
 ;         down and to the left of the small yellow disc that casts it (in fp16 the yellow
 ;         disc's right edge is ragged).

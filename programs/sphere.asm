@@ -3,7 +3,7 @@
 ; Shows:  the basic raytrace: a red unit sphere 3 units in front of the camera (which looks
 ;         down -z from the origin), lit by a white directional light shining from the
 ;         upper right, behind the viewer.
-; Run:    rend3r emulate programs/sphere.asm -o sphere.png
+; Run:    rend3r emulate programs/sphere.asm -o out/sphere.png
 ; Look:   a red disc in the middle of a black screen, brightest towards the upper right,
 ;         shading to black on the lower left where the surface faces away from the light.
 ; frames: 1

@@ -8,7 +8,7 @@
 ;         spheres are kept large compared with their distance: a wall of 64 x 64 tiny
 ;         spheres would lose most of them to float16 cancellation in the quadratic (see
 ;         docs/numerics.md and fp16_cancel.asm).
-; Run:    rend3r emulate programs/stress4096.asm -o stress4096.png --stats
+; Run:    rend3r emulate programs/stress4096.asm -o out/stress4096.png --stats
 ; Look:   an 8 x 8 block of shaded beads lit from the upper right: blue at the lower
 ;         left, magenta at the lower right, cyan at the upper left, pale lavender at the
 ;         upper right; slivers of the spheres behind show through the gaps. In fp16 every

@@ -6,7 +6,7 @@
 ;         section tilted 60 degrees about x and 20 about y (a non-unit quaternion, the raw
 ;         sum of the two, to show the emulator uses the given q as is). Right: a cone
 ;         turned 45 degrees about z then 90 about x.
-; Run:    rend3r emulate programs/transforms.asm -o transforms.png
+; Run:    rend3r emulate programs/transforms.asm -o out/transforms.png
 ; Look:   the white double cone dominates: its near nappe a bright fan opening to the
 ;         lower right from an apex right of centre (frayed in fp16), its far nappe almost
 ;         black over the upper left, with a faint grey wedge running up to the top edge;

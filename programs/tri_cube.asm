@@ -6,7 +6,7 @@
 ;         face: +x red, -x cyan, +y green, -y magenta, +z blue, -z yellow. Triangles use
 ;         every material value 0..3 (materials do not change the image) and set the zero
 ;         property.
-; Run:    rend3r emulate programs/tri_cube.asm --mode raster -o tri_cube.png
+; Run:    rend3r emulate programs/tri_cube.asm --mode raster -o out/tri_cube.png
 ; Look:   three faces visible: blue (front, +z), green (top, +y) and cyan (left, -x),
 ;         each flat-shaded by the light from the upper left, with straight shared edges
 ;         and no gap between the two triangles of a face.

@@ -4,7 +4,7 @@
 ;         at z = -6 (farther, larger) second, so drawing in program order alone would paint
 ;         green over red; a blue triangle tilted in depth (z from -3 to -7) pierces both.
 ;         The two triangles sharing the edge at the bottom are given in opposite windings.
-; Run:    rend3r emulate programs/tri_overlap.asm --mode raster -o tri_overlap.png
+; Run:    rend3r emulate programs/tri_overlap.asm --mode raster -o out/tri_overlap.png
 ; Look:   red in front of green where they overlap; the blue sliver, narrow at the left
 ;         screen edge and widening to the right as it tilts away, passes behind the red
 ;         triangle and in front of the green one until it pierces it near the green one's

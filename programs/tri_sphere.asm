@@ -5,7 +5,7 @@
 ;         in float64, rounded to float16 by the assembler), wound counter-clockwise seen
 ;         from outside. Each facet's colour is made
 ;         from its ring (red up, blue down the rings) and segment (green around).
-; Run:    rend3r emulate programs/tri_sphere.asm --mode raster -o tri_sphere.png
+; Run:    rend3r emulate programs/tri_sphere.asm --mode raster -o out/tri_sphere.png
 ; Look:   a faceted ball of flat-shaded quads, bluish at the top and dark red at the
 ;         bottom, lit from the upper right, with no holes between facets; its lower-left
 ;         quarter faces away from the light and is black, so the ball looks cut away there.

@@ -184,7 +184,8 @@ class EthernetLink(Link):
         except PermissionError as exc:
             raise Rend3rError(
                 f"no permission to open a raw socket on {iface}: run as root or give the "
-                "Python interpreter CAP_NET_RAW (setcap cap_net_raw+ep ...), or use --pcap"
+                "Python interpreter CAP_NET_RAW (setcap cap_net_raw+ep ...), or write the frames to a file "
+                "with -o FILE.pcap"
             ) from exc
         try:
             self.sock.bind((iface, ethertype))

@@ -72,6 +72,7 @@ def test_unknown_interface_and_no_raw_socket_permission(tmp_path):
                  f"setpriv --bounding-set -net_raw {' '.join(RENDER)} send {prog} --eth v0")
     assert r.returncode == 1, r.stderr
     assert "no permission to open a raw socket on v0" in r.stderr and "CAP_NET_RAW" in r.stderr
+    assert "-o FILE.pcap" in r.stderr and "--pcap" not in r.stderr
     assert "Traceback" not in r.stderr
 
 

@@ -72,20 +72,20 @@ def check_output(path: PathLike, kinds: Sequence[str], *, make_parents: bool = F
 Sink = Callable[[Path, bytes], None]
 
 
-def write_image(path: PathLike, image, kinds: Sequence[str] = FRAME_KINDS, *, make_parents: bool = False,
-                sink: Sink | None = None, **save_kwargs) -> None:
+def write_image(path: PathLike, image, kinds: Sequence[str] = FRAME_KINDS, *, sink: Sink | None = None,
+                **save_kwargs) -> None:
     """Encode ``image`` in memory by ``path``'s extension and write it atomically.
 
     ``image`` is a PIL image (``save_kwargs`` go to its encoder) or, for ``.npy``, a numpy
-    array. The extension must be one of ``kinds``; the parent folder must exist unless
-    ``make_parents`` (used for ``{n}`` output patterns). Every failure is a Rend3rError
-    and leaves no partial file behind (:func:`rend3r.fileio.write_atomic`). With ``sink``
-    (:class:`rend3r.emu.outputs.Outputs.write`), the bytes go there instead.
+    array. The extension must be one of ``kinds``; the parent folder must exist unless a
+    ``sink`` (:meth:`rend3r.fileio.Outputs.write`, which makes missing folders) takes the
+    bytes instead. Every failure is a Rend3rError and leaves no partial file behind
+    (:func:`rend3r.fileio.write_atomic`).
     """
     from ..fileio import write_atomic
 
     p = Path(path)
-    ext = check_output(p, kinds, make_parents=make_parents or sink is not None)
+    ext = check_output(p, kinds, make_parents=sink is not None)
     buf = io.BytesIO()
     try:
         if FORMATS[ext] == "NPY":
@@ -97,17 +97,12 @@ def write_image(path: PathLike, image, kinds: Sequence[str] = FRAME_KINDS, *, ma
     if sink is not None:
         sink(p, buf.getbuffer())
         return
-    if make_parents:
-        try:
-            p.parent.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise Rend3rError(f"{p}: cannot create folder {p.parent}: {exc.strerror or exc}") from None
     write_atomic(p, buf.getbuffer())
 
 
-def save_png(rgb565: np.ndarray, path: PathLike, *, make_parents: bool = False, sink: Sink | None = None) -> None:
+def save_png(rgb565: np.ndarray, path: PathLike, *, sink: Sink | None = None) -> None:
     """One frame as an 8-bit RGB PNG."""
-    write_image(path, _image(rgb565), make_parents=make_parents, sink=sink)
+    write_image(path, _image(rgb565), sink=sink)
 
 
 def save_animation(frames: Sequence[np.ndarray], path: PathLike, kind: str, frame_ms: int = 100, *,
@@ -123,10 +118,10 @@ def save_animation(frames: Sequence[np.ndarray], path: PathLike, kind: str, fram
                 loop=0, **extra)
 
 
-def save_depth(depth: np.ndarray, path: PathLike, *, make_parents: bool = False, sink: Sink | None = None) -> None:
+def save_depth(depth: np.ndarray, path: PathLike, *, sink: Sink | None = None) -> None:
     """``.npy``: the float32 distances; ``.png``: 16-bit grey, nearest white, misses black."""
     image = depth_image(depth, str(path).lower().endswith(".npy"))
-    write_image(path, image, DATA_KINDS, make_parents=make_parents, sink=sink)
+    write_image(path, image, DATA_KINDS, sink=sink)
 
 
 def depth_image(depth: np.ndarray, npy: bool):
@@ -152,11 +147,10 @@ def depth_image(depth: np.ndarray, npy: bool):
     return Image.fromarray(grey.reshape(np.shape(depth)))
 
 
-def save_provenance(provenance: np.ndarray, path: PathLike, *, make_parents: bool = False,
-                    sink: Sink | None = None) -> None:
+def save_provenance(provenance: np.ndarray, path: PathLike, *, sink: Sink | None = None) -> None:
     """``.npy``: int32 shape indices (-1 none); ``.png``: one colour per shape."""
     image = provenance_image(provenance, str(path).lower().endswith(".npy"))
-    write_image(path, image, DATA_KINDS, make_parents=make_parents, sink=sink)
+    write_image(path, image, DATA_KINDS, sink=sink)
 
 
 def provenance_image(provenance: np.ndarray, npy: bool):

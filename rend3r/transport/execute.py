@@ -12,7 +12,6 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
-from .. import cliutil
 from ..errors import Rend3rError
 
 if TYPE_CHECKING:
@@ -24,14 +23,6 @@ log = logging.getLogger("rend3r.device")
 #: The virtual device renders frames of at most this many pixels per side: a frame is rendered
 #: for each program a sender pushes, so the cap bounds the work one received program causes.
 MAX_DEVICE_SIDE = 4096
-
-
-def parse_size(text: str) -> tuple[int, int]:
-    """``WxH`` to (width, height), each 1..MAX_DEVICE_SIDE; Rend3rError if malformed."""
-    try:
-        return cliutil.parse_size(text, max_side=MAX_DEVICE_SIDE)
-    except ValueError as exc:
-        raise Rend3rError(f"malformed size: {exc}") from None
 
 
 #: A program starts rendering once no newer one has arrived for this long (seconds).

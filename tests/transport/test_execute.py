@@ -9,18 +9,9 @@ import numpy as np
 import pytest
 
 from rend3r.asm.assembler import assemble_or_raise
-from rend3r.errors import Rend3rError
-from rend3r.transport.execute import MAX_DEVICE_SIDE, RenderExecutor, parse_size
+from rend3r.transport.execute import RenderExecutor
 
 PROGRAMS = Path(__file__).resolve().parents[2] / "programs"
-
-
-def test_size_uses_the_shared_parser_with_the_device_cap():
-    assert parse_size("128x96") == (128, 96)
-    assert parse_size(f"{MAX_DEVICE_SIDE}x1") == (MAX_DEVICE_SIDE, 1)
-    for text, why in (("0x5", "1..4096"), ("4097x1", "1..4096"), ("١٢x3", "WIDTHxHEIGHT"), ("big", "WIDTHxHEIGHT")):
-        with pytest.raises(Rend3rError, match=f"malformed size: .*{why}"):
-            parse_size(text)
 
 
 def _wait(cond, seconds=60.0):

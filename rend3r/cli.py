@@ -8,6 +8,8 @@ scapy-heavy modules they do not use.
 from __future__ import annotations
 
 import importlib
+import sys
+from typing import NoReturn
 
 import click
 
@@ -32,6 +34,12 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
+def interrupted() -> NoReturn:
+    """Ctrl-C: say so on stderr and exit 130, without a traceback."""
+    click.echo("\nrend3r: interrupted", err=True)
+    sys.exit(INTERRUPTED)
+
+
 class LazyGroup(click.Group):
     """A click group that imports a command's module only when the command is used."""
 
@@ -43,7 +51,11 @@ class LazyGroup(click.Group):
             return None
         target, _ = COMMANDS[name]
         module_name, attr = target.split(":")
-        return getattr(importlib.import_module(module_name), attr)
+        try:
+            module = importlib.import_module(module_name)
+        except KeyboardInterrupt:  # Ctrl-C while the command loads: nothing has run yet
+            interrupted()
+        return getattr(module, attr)
 
     def invoke(self, ctx: click.Context):
         reuse_freed_memory()  # the renderers' temporaries: see rend3r/memory.py
@@ -53,8 +65,7 @@ class LazyGroup(click.Group):
             click.echo(str(exc) if exc.preformatted else f"rend3r: error: {exc}", err=True)
             ctx.exit(exc.exit_code)
         except KeyboardInterrupt:  # Ctrl-C: the run's outputs were never committed
-            click.echo("\nrend3r: interrupted", err=True)
-            ctx.exit(INTERRUPTED)
+            interrupted()
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         rows = [(name, COMMANDS[name][1]) for name in self.list_commands(ctx)]

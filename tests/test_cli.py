@@ -72,6 +72,20 @@ def test_ctrl_c_exits_130_without_a_traceback_or_output(tmp_path):
     assert not out.exists()
 
 
+def test_ctrl_c_while_a_command_loads_exits_130(monkeypatch):
+    """Ctrl-C during the lazy import of a command's module: exit 130 and one line, not
+    click's 'Aborted!' with status 1."""
+    import importlib
+
+    def interrupt(name, *args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(importlib, "import_module", interrupt)
+    result = CliRunner().invoke(main, ["emulate", "--help"])
+    assert result.exit_code == 130
+    assert "rend3r: interrupted" in result.output and "Aborted" not in result.output
+
+
 def test_exit_statuses_follow_one_convention(tmp_path):
     """0 success, 1 an error, 2 a bad command line (130 for Ctrl-C: above)."""
     src = tmp_path / "s.asm"

@@ -1,4 +1,5 @@
-"""Option parsing shared by the commands: image sizes ``WxH``, thread counts, memory budgets."""
+"""Option parsing shared by the commands: image sizes ``WxH``, working precisions, thread counts,
+memory budgets."""
 
 from __future__ import annotations
 
@@ -50,6 +51,28 @@ SIZE = SizeType()
 
 #: The device's frame size, the default ``--size`` of every command that renders.
 DEVICE_SIZE = "512x384"
+
+
+class PrecisionType(click.ParamType):
+    """``--precision``: a working format's name, checked and made canonical (bad names exit 2).
+    The emulator's arithmetic module is imported only when a value is converted."""
+
+    name = "FORMAT"
+
+    def convert(self, value, param, ctx) -> str:
+        from .emu.arith import precision_name
+
+        try:
+            return precision_name(str(value))
+        except ValueError as exc:
+            self.fail(str(exc), param, ctx)
+
+
+#: ``--precision FORMAT``: the emulator's working precision.
+PRECISION = click.option(
+    "--precision", type=PrecisionType(), default="fp16", show_default=True,
+    help="Working precision: fp16 (the device), fp32, fp64, or any binary format eEmM (E exponent bits 2..11, "
+         "M fraction bits 1..52) or alias bf16, tf32, fp24 (docs/precision.md).")
 
 
 #: ``--jobs N``: threads rendering each frame (0, the default: every core this process may use).

@@ -9,22 +9,47 @@ Every operation rounds its result to the working format, as one hardware unit wo
   operation. With ``ftz`` (the vendor IP's treatment) subnormal results and loaded
   subnormal values become signed zero, so no operation ever sees a subnormal input.
 - ``fp32`` / ``fp64``: native numpy arithmetic in that format (``ftz`` does not apply).
+- any other format ``eEmM`` (:mod:`rend3r.precision`): values held in float64, each
+  operation correctly rounded to the format (:mod:`rend3r.precision.ops`), ``ftz``
+  flushing results below the smallest normal number (tininess after rounding, as fp16).
+  ``e5m10``, ``e8m23`` and ``e11m52`` are fp16, fp32 and fp64 themselves.
 
 Arrays are held as float32 for fp16 and fp32 (fp16 values are exact in float32), float64
-for fp64. Overflow gives infinities and invalid operations NaN, silently here: callers
+otherwise. Overflow gives infinities and invalid operations NaN, silently here: callers
 decide what a non-finite value means (the raytracer counts such rays as misses).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Literal
 
 import numpy as np
 
-Precision = Literal["fp16", "fp32", "fp64"]
+from ..precision import ops
+from ..precision.formats import FloatFormat, FormatError, parse
+
+#: A working precision: "fp16", "fp32", "fp64" or another format's name ("e8m7").
+Precision = str
+#: The precisions with kernels of their own; any other format runs the format kernels.
 PRECISIONS: tuple[Precision, ...] = ("fp16", "fp32", "fp64")
+_NATIVE = {(5, 10): "fp16", (8, 23): "fp32", (11, 52): "fp64"}
+_NATIVE_BITS = {"fp16": (np.float16, np.uint16), "fp32": (np.float32, np.uint32), "fp64": (np.float64, np.uint64)}
 _FP16_MIN_NORMAL = np.float32(2.0**-14)
+
+
+def precision_name(text: str) -> Precision:
+    """The canonical name of a ``--precision`` value: an alias or ``eEmM``; fp16, fp32 and
+    fp64 for their own formats. ValueError naming what is wrong otherwise."""
+    if "-" in text:
+        raise ValueError(f"bad precision {text!r}: give the subnormal mode with --subnormals, not in the name")
+    try:
+        fmt = parse(text)
+    except FormatError as exc:
+        raise ValueError(str(exc)) from None
+    return _NATIVE.get((fmt.exp_bits, fmt.frac_bits), fmt.name)
 
 
 @dataclass(frozen=True)
@@ -34,28 +59,60 @@ class Arith:
     precision: Precision = "fp16"
     ftz: bool = True
 
+    @cached_property
+    def format(self) -> FloatFormat:
+        """The working format (fp32 and fp64 never flush)."""
+        ftz = self.ftz and self.precision not in ("fp32", "fp64")
+        return parse(self.precision, "ftz" if ftz else "ieee")
+
+    @property
+    def native(self) -> bool:
+        """fp16, fp32 or fp64: kernels of their own, float32 or float64 arrays."""
+        return self.precision in PRECISIONS
+
     @property
     def dtype(self) -> type[np.floating]:
-        return np.float64 if self.precision == "fp64" else np.float32
+        return np.float32 if self.precision in ("fp16", "fp32") else np.float64
 
     @property
     def unit_roundoff(self) -> float:
         """Half an ulp of 1: the largest relative error of one rounding (normal range)."""
-        return {"fp16": 2.0**-11, "fp32": 2.0**-24, "fp64": 2.0**-53}[self.precision]
+        return self.format.unit_roundoff
 
     @property
     def tiny(self) -> float:
         """The smallest normal number: below it results flush or lose relative precision."""
-        return {"fp16": 2.0**-14, "fp32": 2.0**-126, "fp64": 2.0**-1022}[self.precision]
+        return self.format.min_normal
 
     @property
     def label(self) -> str:
-        if self.precision == "fp16":
-            return f"fp16-{'ftz' if self.ftz else 'ieee'}"
-        return self.precision
+        if self.precision in ("fp32", "fp64"):
+            return self.precision
+        return f"{self.precision}-{'ftz' if self.ftz else 'ieee'}"
+
+    def bits(self, value: float) -> tuple[int, int]:
+        """A working-precision value's bit pattern in the working format (NaN: the quiet NaN
+        of its sign, fp32 and fp64 as they hold it), and the pattern's width in hex digits."""
+        if self.precision in _NATIVE_BITS:
+            ftype, itype = _NATIVE_BITS[self.precision]
+            return int(np.asarray(value, dtype=ftype).view(itype)), np.dtype(itype).itemsize * 2
+        f, v = self.format, float(value)
+        top = (1 << f.exp_bits) - 1
+        if math.isnan(v):
+            e, m = top, 1 << (f.frac_bits - 1)
+        elif math.isinf(v):
+            e, m = top, 0
+        elif abs(v) >= f.min_normal:
+            mant, exp = math.frexp(abs(v))  # |v| = mant * 2**exp, mant in [0.5, 1)
+            e, m = exp - 1 + f.bias, int(math.ldexp(mant * 2 - 1, f.frac_bits))
+        else:  # zero or subnormal: multiples of the least subnormal
+            e, m = 0, int(math.ldexp(abs(v), f.frac_bits - f.emin))
+        return (int(math.copysign(1, v) < 0) << (f.bits - 1)) | (e << f.frac_bits) | m, -(-f.bits // 4)
 
     def round(self, x: np.ndarray | float) -> np.ndarray:
         """Round values (already in or above working precision) to the working format."""
+        if not self.native:
+            return self.format.round(np.asarray(x, dtype=np.float64))
         if self.precision != "fp16":
             return np.asarray(x, dtype=self.dtype)
         a = np.asarray(x)
@@ -72,22 +129,32 @@ class Arith:
         return self.round(np.float64(value))
 
     def add(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        if not self.native:
+            return ops.add(self.format, a, b)
         with np.errstate(all="ignore"):
             return self.round(np.add(a, b, dtype=self.dtype))
 
     def sub(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        if not self.native:
+            return ops.sub(self.format, a, b)
         with np.errstate(all="ignore"):
             return self.round(np.subtract(a, b, dtype=self.dtype))
 
     def mul(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        if not self.native:
+            return ops.mul(self.format, a, b)
         with np.errstate(all="ignore"):
             return self.round(np.multiply(a, b, dtype=self.dtype))
 
     def div(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        if not self.native:
+            return ops.div(self.format, a, b)
         with np.errstate(all="ignore"):
             return self.round(np.divide(a, b, dtype=self.dtype))
 
     def sqrt(self, a: np.ndarray) -> np.ndarray:
+        if not self.native:
+            return ops.sqrt(self.format, a)
         with np.errstate(all="ignore"):
             return self.round(np.sqrt(np.asarray(a, dtype=self.dtype)))
 
@@ -148,7 +215,5 @@ def _round16_f32(a: np.ndarray, ftz: bool) -> np.ndarray:
 
 
 def make_arith(precision: Precision = "fp16", subnormals: Literal["ftz", "ieee"] = "ftz") -> Arith:
-    """The arithmetic for a ``--precision`` / ``--subnormals`` pair."""
-    if precision not in PRECISIONS:
-        raise ValueError(f"unknown precision {precision!r}; expected one of {', '.join(PRECISIONS)}")
-    return Arith(precision, subnormals == "ftz")
+    """The arithmetic for a ``--precision`` / ``--subnormals`` pair (ValueError for a bad name)."""
+    return Arith(precision_name(precision), subnormals == "ftz")

@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 import io
-import sys
 import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 
 import click
 
-from ..cliutil import JOBS, MAX_MEMORY, SIZE
+from ..cliutil import JOBS, MAX_MEMORY, PRECISION, SIZE
+from ..progress import Progress, quiet_option
 from ..errors import Rend3rError
 
 _EPILOG = """\b
@@ -18,6 +18,7 @@ Examples:
   rend3r emulate programs/sphere.asm -o sphere.png
   rend3r emulate programs/animation.asm --frames 24 -o out/frame_{n:03}.png --gif anim.gif
   rend3r emulate sphere.mem -o s.png --precision fp32 --size 256x192 --depth-image d.png --stats
+  rend3r emulate programs/shadow.asm -o bf16.png --precision bf16 --subnormals ieee
   rend3r emulate programs/stress4096.asm -o s.png --jobs 1
   rend3r emulate programs/tri_cube.asm -o cube.png --depth painter
   rend3r emulate programs/sphere.asm -o board.png --profile rend3r-2022 --trace-pixel 252,188 --trace t.jsonl
@@ -53,8 +54,8 @@ def _pattern(ctx, param, value: str | None) -> str | None:
               "as {{ or }}.")
 @click.option("--frames", type=click.IntRange(min=1), metavar="N", help="Render at most N frames (required for programs that loop with lr).")
 @click.option("--mode", type=click.Choice(["raytrace", "raster", "hybrid"]), help="How SE/SD data is read (default: from the source's sp/tr, else raytrace); hybrid: shapes and triangles in one frame (docs/isa-extensions.md).")
-@click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
-@click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormals: flush to zero (the device's IP) or IEEE gradual underflow.")
+@PRECISION
+@click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="Subnormals of fp16 and the other narrow formats: flush to zero (the device's IP) or IEEE gradual underflow.")
 @click.option("--size", type=SIZE, default="512x384", show_default=True, help="Image size WxH (1..8192 each).")
 @click.option("--background", default="0x0000", show_default=True, callback=_colour, metavar="RGB565", help="RGB565 colour where no shape is hit.")
 @click.option("--depth", "visibility", type=click.Choice(["zbuffer", "painter"]), default="zbuffer", show_default=True,
@@ -70,9 +71,10 @@ def _pattern(ctx, param, value: str | None) -> str | None:
 @click.option("--trace", "trace_path", metavar="FILE", help="Write pixel traces (JSON lines) to FILE instead of standard output.")
 @JOBS
 @MAX_MEMORY
+@quiet_option
 def emulate_command(program, output, frames, mode, precision, subnormals, size, background, visibility,
                     depth_path, prov_path, gif_path, apng_path, show_stats, profile, quirks, trace_pixels,
-                    trace_path, jobs, max_memory) -> None:
+                    trace_path, jobs, max_memory, quiet) -> None:
     """Run a REND3R PROGRAM (source or memory image) and render its frames.
 
     Its outputs are all or nothing: they appear only when every one of them was written;
@@ -141,7 +143,6 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
     for path in (animate, trace_path):
         if path:
             outputs.reserve(path)
-    bar = _progress_bar(count)
     rgb_frames = []
 
     def on_frame(frame) -> None:
@@ -154,9 +155,12 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
         if animate:
             rgb_frames.append(frame.rgb565)
 
+    done = [0]  # thousandths of a frame
+
     def progress(number: int, fraction: float) -> None:
-        if bar is not None:
-            bar.update(int((number + fraction) * 1000) - bar.pos)
+        units = int((number + fraction) * 1000)
+        bar.advance(units - done[0])
+        done[0] = units
 
     trace_buf = io.StringIO()
     on_scene = None
@@ -173,12 +177,9 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
     # rays count as misses and are reported below, so numpy's own warnings are not shown.
     with outputs, np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        try:
+        with Progress(count * 1000, "rendering", quiet=quiet) as bar:
             result = run_program(loaded.words, options, frames, on_frame, progress, keep_frames=False,
                                  on_scene=on_scene)
-        finally:
-            if bar is not None:
-                bar.render_finish()
         if trace_path:
             outputs.write(trace_path, trace_buf.getvalue().encode())
         if animate:
@@ -228,11 +229,3 @@ def _refuse_contradictions(selected: list[str], profile: str | None, quirks: tup
         raise click.UsageError(f"{options[field]} {given[field]} contradicts {source}, which sets {field} to "
                                f"{value}: drop one of the two (docs/device-profile.md)")
 
-
-def _progress_bar(frames: int):
-    """A progress bar on stderr when it is a terminal (units: thousandths of a frame)."""
-    if not sys.stderr.isatty():
-        return None
-    bar = click.progressbar(length=frames * 1000, label="rendering", file=sys.stderr)
-    bar.render_progress()
-    return bar

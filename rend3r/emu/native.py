@@ -18,6 +18,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import Rend3rError
+from ..precision.formats import FloatFormat
 
 # Column layouts shared with csrc/kernels.h.
 SF_LOC, SF_ROT, SF_INV, SF_ZSIGN, SF_ONE, SF_SHAT, SF_C2, SF_COLUMNS = 0, 3, 7, 10, 11, 12, 15, 16
@@ -34,9 +35,23 @@ PC_COLUMNS = 7
 CONE_COLUMNS = 6  # cone_balls: unit axis, half-angle, its sine and cosine
 
 
+class Format(Structure):
+    """A working format of the _fmt kernels (csrc/fformat.h)."""
+
+    _fields_ = [("drop", c_int64), ("max_bits", c_uint64), ("min_normal_bits", c_uint64),
+                ("subnormal_magic", c_double), ("ftz", c_int32), ("wide", c_int32)]
+
+    @classmethod
+    def of(cls, fmt: FloatFormat) -> Format:
+        bits = lambda x: int(np.float64(x).view(np.uint64))  # noqa: E731
+        return cls(52 - fmt.frac_bits, bits(fmt.max), bits(fmt.min_normal),
+                   float(np.ldexp(1.0, fmt.emin - fmt.frac_bits + 52)), int(fmt.ftz),
+                   int(fmt.frac_bits > 25 or fmt.exp_bits == 11))
+
+
 class Shapes(Structure):
     _fields_ = [("sf", c_void_p), ("si", c_void_p), ("bnd", c_void_p), ("n", c_int64), ("u", c_double),
-                ("tiny", c_double)]
+                ("tiny", c_double), ("format", POINTER(Format))]
 
 
 class Grid(Structure):
@@ -81,16 +96,17 @@ def ptr(a: np.ndarray, dtype: type | np.dtype, shape: tuple[int | None, ...]) ->
     return a.ctypes.data
 
 
-#: Kernel suffix per (precision, flush subnormals).
+#: Kernel suffix per (precision, flush subnormals); every other format's kernels are FORMAT's.
 SUFFIXES = {("fp16", True): "h16", ("fp16", False): "h16i", ("fp32", True): "f32", ("fp32", False): "f32",
             ("fp64", True): "f64", ("fp64", False): "f64"}
+FORMAT = "fmt"
 _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and instruction set
     "directions": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "pixel_cells": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "nearest": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "origin_terms": (None, [POINTER(Shapes), c_void_p]),
     "shape_tables": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p,
-                               c_void_p, c_void_p]),
+                               c_void_p, c_void_p, POINTER(Format)]),
     "shadow_directions": (None, [POINTER(Shapes), c_void_p, c_void_p]),
     "light_pass": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
     "shadow_origins": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
@@ -126,7 +142,7 @@ def library() -> ctypes.CDLL:
     lib = ctypes.CDLL(spec.origin)
     table = dict(_PLAIN)
     for name, sig in _SUFFIXED.items():
-        for suffix in set(SUFFIXES.values()):
+        for suffix in {*SUFFIXES.values(), FORMAT}:
             for isa in ("base", "avx2"):
                 table[f"{name}_{suffix}_{isa}"] = sig
     for name, (restype, argtypes) in table.items():
@@ -146,8 +162,9 @@ def isa() -> str:
 
 
 def kernel(name: str, precision: str, ftz: bool) -> ctypes._CFuncPtr:
-    """The kernel ``name`` compiled for a working precision and subnormal handling."""
-    return getattr(library(), f"{name}_{SUFFIXES[precision, ftz]}_{isa()}")
+    """The kernel ``name`` compiled for a working precision and subnormal handling (any
+    format other than fp16, fp32 and fp64: the format kernels, given the format)."""
+    return getattr(library(), f"{name}_{SUFFIXES.get((precision, ftz), FORMAT)}_{isa()}")
 
 
 def round16(values: np.ndarray, ftz: bool) -> np.ndarray:

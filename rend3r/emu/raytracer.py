@@ -121,11 +121,12 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     cam[native.CAM_TMIN], cam[native.CAM_TMAX], cam[native.CAM_Z] = rays.tmin, rays.tmax, rays.z
     if rays.rotation is not None:  # the kernel turns (x[col], y[row], z) per pixel
         cam[native.CAM_ROT:native.CAM_ROT + 4] = [np.asarray(c, dtype) for c in rays.rotation]
-    sf, si, bnd, bounded, index = _shape_tables(scene, ar)
+    fmt = None if ar.native else pointer(native.Format.of(ar.format))
+    sf, si, bnd, bounded, index = _shape_tables(scene, ar, fmt)
     lights = lights_from_scene(scene, ar, options.light_model)
     n = len(sf)
     view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
-                         native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny)
+                         native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny, fmt)
     if n:
         native.kernel("origin_terms", ar.precision, ar.ftz)(byref(view), native.ptr(cam, dtype, (native.CAM_COLUMNS,)))
     return _Frame(ar, dtype, cam, np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype),
@@ -140,9 +141,12 @@ _KINDS = np.array([SHAPE_TYPE_CODES["sphere"], SHAPE_TYPE_CODES["cylinder"], SHA
                    lookup(Table.SHAPE, "type").value_mask], np.int32)
 
 
-def _shape_tables(scene: Scene, ar: Arith) -> tuple[np.ndarray, ...]:
+def _shape_tables(scene: Scene, ar: Arith, fmt) -> tuple[np.ndarray, ...]:
     """The shapes that are on, as the kernels' tables (csrc/datapath.inc shape_tables):
-    (floats, ints, bounds, bounded, program index), in index order."""
+    (floats, ints, bounds, bounded, program index), in index order. Shapes are bounded
+    (culled, csrc/bounds.h) in fp16, fp32, fp64 and formats with fp32's exponent range or
+    wider, whose products of scene values cannot overflow, as section 7 of
+    docs/emulator.md assumes; in narrower formats every ray tests every shape."""
     table = scene.objects
     values = np.ascontiguousarray(table.values, np.uint16)
     index = np.ascontiguousarray(table.index, np.int64)
@@ -154,7 +158,9 @@ def _shape_tables(scene: Scene, ar: Arith) -> tuple[np.ndarray, ...]:
     out = np.empty(rows, np.int32)
     n = native.kernel("shape_tables", ar.precision, ar.ftz)(
         native.ptr(values, np.uint16, (rows, PROP_LIMIT)), index.ctypes.data, rows, _SHAPE_PROPS.ctypes.data,
-        _KINDS.ctypes.data, sf.ctypes.data, si.ctypes.data, bnd.ctypes.data, bounded.ctypes.data, out.ctypes.data)
+        _KINDS.ctypes.data, sf.ctypes.data, si.ctypes.data, bnd.ctypes.data, bounded.ctypes.data, out.ctypes.data, fmt)
+    if not (ar.native or ar.format.exp_bits >= 8):
+        bounded[:] = 0
     return sf[:n], si[:n], bnd[:n], bounded[:n].astype(bool), out[:n]
 
 

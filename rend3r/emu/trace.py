@@ -21,13 +21,11 @@ from .options import EmuOptions
 from .scene import Scene
 
 Emit = Callable[[dict], None]
-_BITS = {"fp16": (np.float16, np.uint16, 4), "fp32": (np.float32, np.uint32, 8), "fp64": (np.float64, np.uint64, 16)}
 
 
 def encode_value(ar: Arith, value: float) -> tuple[str, float | str]:
     """(hex bits in the working format, decimal) of one working-precision value."""
-    ftype, itype, digits = _BITS[ar.precision]
-    bits = int(np.asarray(value, dtype=ftype).view(itype))
+    bits, digits = ar.bits(value)
     v = float(value)
     dec: float | str = v if math.isfinite(v) else ("nan" if math.isnan(v) else ("inf" if v > 0 else "-inf"))
     return f"0x{bits:0{digits}x}", dec

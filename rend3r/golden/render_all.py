@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import click
 
-from ..cliutil import JOBS, SIZE
+from ..cliutil import JOBS, PRECISION, SIZE
 from ..errors import Rend3rError
 from .catalog import ExampleProgram, program_paths, read_header
 
@@ -76,7 +76,7 @@ def render_all(
 @click.argument("programs_dir", type=click.Path(path_type=Path, file_okay=False), default="programs")
 @click.option("-o", "--output", "out_dir", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="Folder for the PNGs (made if missing).")
-@click.option("--precision", type=click.Choice(["fp16", "fp32", "fp64"]), default="fp16", show_default=True)
+@PRECISION
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormal handling.")
 @click.option("--size", type=SIZE, default="512x384", show_default=True, help="Image size (1..8192 each).")
 @JOBS

@@ -49,7 +49,8 @@ def read(fmt: FloatFormat, a: np.ndarray | float) -> np.ndarray:
     """Operands as the format's units read them: float64, subnormals as signed zero with ftz."""
     v = np.asarray(a, dtype=np.float64)
     if fmt.ftz:
-        wrapped = (v.view(np.uint64) & _ABS) - np.uint64(1)  # zero wraps to the top
+        with np.errstate(over="ignore"):  # numpy warns of the wrap for 0-d values
+            wrapped = (v.view(np.uint64) & _ABS) - np.uint64(1)  # zero wraps to the top
         limit = np.float64(fmt.min_normal).view(np.uint64) - np.uint64(1)
         if v.size and wrapped.min() < limit:
             v = np.where(wrapped < limit, np.copysign(0.0, v), v)

@@ -2,7 +2,7 @@
 shape, numpy): identical pixels, depth bits and provenance on random scenes.
 
 Scenes mix every shape type (and types that are off), rotations, scales, both cameras,
-directional and point lights, every precision with flushed and gradual underflow, the
+directional and point lights, every precision (and other formats eEmM) with flushed and gradual underflow, the
 original board's profile, exact ties (duplicated shapes), and float16 operands that are
 infinite, NaN, subnormal, zero of either sign or the largest finite value. About 600
 scenes run in CI (fixed seed); ``benchmarks/fuzz_engine.py`` runs more.
@@ -66,6 +66,10 @@ camera = st.fixed_dictionaries({
     "nclip": st.one_of(st.just(0), f16(0.05, 4, 0.02)), "fclip": st.one_of(st.just(0), f16(1, 60, 0.02)),
 })
 precision = st.sampled_from([("fp16", "ftz"), ("fp16", "ieee"), ("fp32", "ftz"), ("fp64", "ftz")])
+#: Other formats (the format kernels): narrow and wide exponents, fractions that round in
+#: double innocuously (M <= 25) or through round to odd (M > 25, and every e11 format).
+other_format = st.tuples(st.sampled_from(["bf16", "tf32", "fp24", "e4m3", "e5m2", "e3m6", "e6m12", "e8m30",
+                                          "e9m40", "e11m20", "e11m51"]), st.sampled_from(["ftz", "ieee"]))
 
 
 def _prop(table: Table, name: str) -> int:
@@ -156,6 +160,14 @@ scene_args = (camera, st.lists(light, max_size=3), st.lists(shape, min_size=1, m
 @given(*scene_args)
 def test_random_scenes(cam, lights, shapes, ties, prec):
     options = EmuOptions(precision=prec[0], subnormals=prec[1], width=24, height=18)
+    check(program(cam, lights, shapes, ties, options), options)
+
+
+@settings(max_examples=150, derandomize=True)
+@given(*scene_args[:-1], other_format)
+def test_random_scenes_in_other_formats(cam, lights, shapes, ties, fmt):
+    """Any format eEmM: the format kernels against the reference's exactly rounded numpy."""
+    options = EmuOptions(precision=fmt[0], subnormals=fmt[1], width=24, height=18)
     check(program(cam, lights, shapes, ties, options), options)
 
 

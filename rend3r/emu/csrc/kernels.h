@@ -42,12 +42,23 @@ enum { TRACE_SHAPE_VALUES = 22, TRACE_LIGHT_VALUES = 12 };
  * rays, hit pixels with a finite hit point and those points' bounding box. */
 enum { OUT_TESTS = 0, OUT_NAN_TESTS = 1, OUT_SHADOW_RAYS = 2, OUT_HITS = 3, OUT_LO = 4, OUT_HI = 7, OUT_COLUMNS = 10 };
 
+/* A working format eEmM of the _fmt kernels (csrc/fformat.h; native.py Format). */
+typedef struct {
+    int64_t drop;           /* 52 - M: the double fraction bits a rounding drops */
+    uint64_t max_bits;      /* the largest finite value, as double bits */
+    uint64_t min_normal_bits; /* 2**emin, as double bits */
+    double subnormal_magic; /* 2**(emin - M + 52): adding and subtracting it rounds to the subnormal grid */
+    int32_t ftz;            /* flush results below 2**emin to zero */
+    int32_t wide;           /* M > 25: double rounding is not innocuous, round to odd first */
+} Format;
+
 typedef struct {
     void *sf;               /* n x SF_COLUMNS, working */
     const int64_t *si;      /* n x SI_COLUMNS */
     const double *bnd;      /* n x B_COLUMNS */
     int64_t n;
     double u, tiny;         /* unit roundoff and smallest normal number of the precision */
+    const Format *format;   /* the _fmt kernels' format (NULL for the others) */
 } Shapes;
 
 typedef struct {

@@ -314,7 +314,7 @@ def pcap_frames(path: Path) -> list[bytes]:
 
 @cocotb.test()
 async def rmii_replays_rend3r_send_pcap(dut):
-    """The frames `rend3r send --pcap --run` writes load and run the program.
+    """The frames `rend3r send -o F.pcap --run` writes load and run the program.
 
     They are replayed at the minimum gap, except that RUN waits for COMMIT's ACK, as
     `rend3r send` waits on a live link: the COMMIT's CRC pass keeps the engine busy.
@@ -323,7 +323,7 @@ async def rmii_replays_rend3r_send_pcap(dut):
     pcap = Path(os.environ.get("TMPDIR", "/tmp")) / f"rend3r_firmware_{os.getpid()}.pcap"
     try:
         subprocess.run([sys.executable, "-m", "rend3r", "send", str(REPO / "programs" / "tri_cube.asm"),
-                        "--pcap", str(pcap), "--run"], check=True, capture_output=True)
+                        "-o", str(pcap), "--run"], check=True, capture_output=True)
         frames = pcap_frames(pcap)
     finally:
         pcap.unlink(missing_ok=True)

@@ -109,7 +109,7 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
              (gif_path, ANIMATION_KINDS["gif"]), (apng_path, ANIMATION_KINDS["apng"]))
     for path, kinds in named:
         if path:
-            check_output(path, kinds, make_parents=True)  # the extension; folders are checked by reserve()
+            check_output(path, kinds)  # the extension; folders are checked by reserve()
     loaded = load_program(program)
     options = EmuOptions(precision=precision, subnormals=subnormals, mode=mode or loaded.mode_hint or "raytrace",
                          width=size[0], height=size[1], background=background, depth=visibility, jobs=jobs)

@@ -55,16 +55,14 @@ DATA_KINDS = (".png", ".npy")
 ANIMATION_KINDS = {"gif": (".gif",), "apng": (".png", ".apng")}
 
 
-def check_output(path: PathLike, kinds: Sequence[str], *, make_parents: bool = False) -> str:
-    """The lower-case extension of ``path`` if it is one of ``kinds`` and (unless
-    ``make_parents``) its folder exists; Rend3rError otherwise. Lets a command refuse an
-    output before it spends time rendering."""
+def check_output(path: PathLike, kinds: Sequence[str]) -> str:
+    """The lower-case extension of ``path`` if it is one of ``kinds``; Rend3rError
+    otherwise. Lets a command refuse an output before it spends time rendering (folders
+    are made, or refused, by :mod:`rend3r.fileio`)."""
     p = Path(path)
     ext = p.suffix.lower()
     if ext not in kinds:
         raise Rend3rError(f"{p}: unknown image type {ext or '(no extension)'!r}: use {' or '.join(kinds)}")
-    if not make_parents and not p.parent.is_dir():
-        raise Rend3rError(f"{p}: folder {p.parent} does not exist")
     return ext
 
 
@@ -77,15 +75,14 @@ def write_image(path: PathLike, image, kinds: Sequence[str] = FRAME_KINDS, *, si
     """Encode ``image`` in memory by ``path``'s extension and write it atomically.
 
     ``image`` is a PIL image (``save_kwargs`` go to its encoder) or, for ``.npy``, a numpy
-    array. The extension must be one of ``kinds``; the parent folder must exist unless a
-    ``sink`` (:meth:`rend3r.fileio.Outputs.write`, which makes missing folders) takes the
-    bytes instead. Every failure is a Rend3rError and leaves no partial file behind
-    (:func:`rend3r.fileio.write_atomic`).
+    array. The extension must be one of ``kinds``; a ``sink`` (:meth:`rend3r.fileio.Outputs.write`)
+    may take the bytes instead. Missing folders are made; every failure is a Rend3rError and
+    leaves no partial file behind (:func:`rend3r.fileio.write_atomic`).
     """
     from ..fileio import write_atomic
 
     p = Path(path)
-    ext = check_output(p, kinds, make_parents=sink is not None)
+    ext = check_output(p, kinds)
     buf = io.BytesIO()
     try:
         if FORMATS[ext] == "NPY":

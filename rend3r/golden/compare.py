@@ -60,7 +60,7 @@ def compare_files(
         from ..emu.image import check_output
         from ..fileio import check_writable
 
-        check_output(diff, (".png",), make_parents=True)
+        check_output(diff, (".png",))
         check_writable(diff)
     x = as_rgb888(load_image(a, size))
     y = as_rgb888(load_image(b, size))

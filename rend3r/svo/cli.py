@@ -269,7 +269,7 @@ def render_cmd(model: str, output: str, size, mode: str, stack: int, use_float: 
     with Outputs() as out:
         for path in (output, cost_path):
             if path:
-                check_output(path, (".png",), make_parents=True)
+                check_output(path, (".png",))
                 out.reserve(path)
         if place is not None and program is None:
             raise Rend3rError("--place needs --with-program")

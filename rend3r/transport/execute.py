@@ -157,10 +157,12 @@ class RenderExecutor:
 
 
 def _write_png(frame: Frame, path: Path, check: Callable[[], None]) -> None:
-    """Encode the frame (abandoned between bands when ``check`` raises) and write it atomically."""
-    from ..emu.image import check_output
+    """Encode the frame (abandoned between bands when ``check`` raises) and write it
+    atomically, into the folder the device was started with: a folder removed while it
+    runs is reported, not made again."""
     from ..fileio import write_atomic
     from .png import encode_rgb565
 
-    check_output(path, (".png",))
+    if not path.parent.is_dir():
+        raise Rend3rError(f"{path}: folder {path.parent} does not exist")
     write_atomic(path, encode_rgb565(frame.rgb565, check))

@@ -12,7 +12,9 @@ Every operation rounds its result to the working format, as one hardware unit wo
 - any other format ``eEmM`` (:mod:`rend3r.precision`): values held in float64, each
   operation correctly rounded to the format (:mod:`rend3r.precision.ops`), ``ftz``
   flushing results below the smallest normal number (tininess after rounding, as fp16).
-  ``e5m10``, ``e8m23`` and ``e11m52`` are fp16, fp32 and fp64 themselves.
+  ``e5m10``, ``e8m23`` and ``e11m52`` are fp16, fp32 and fp64 themselves. ``tininess``
+  ``"before"`` (a device quirk) flushes results whose unrounded value is below the
+  smallest normal, so fp16 then runs as such a format too.
 
 Arrays are held as float32 for fp16 and fp32 (fp16 values are exact in float32), float64
 otherwise. Overflow gives infinities and invalid operations NaN, silently here: callers
@@ -29,7 +31,7 @@ from typing import Literal
 import numpy as np
 
 from ..precision import ops
-from ..precision.formats import FloatFormat, FormatError, parse
+from ..precision.formats import FloatFormat, FormatError, Tininess, parse
 
 #: A working precision: "fp16", "fp32", "fp64" or another format's name ("e8m7").
 Precision = str
@@ -58,6 +60,7 @@ class Arith:
 
     precision: Precision = "fp16"
     ftz: bool = True
+    tininess: Tininess = "after"  # with ftz: a result is tiny judged after rounding, or before
 
     @cached_property
     def format(self) -> FloatFormat:
@@ -67,12 +70,13 @@ class Arith:
 
     @property
     def native(self) -> bool:
-        """fp16, fp32 or fp64: kernels of their own, float32 or float64 arrays."""
-        return self.precision in PRECISIONS
+        """fp16, fp32 or fp64 as the device's IP rounds them: kernels of their own, float32
+        or float64 arrays (fp16 judging tininess before rounding runs as any other format)."""
+        return self.precision in PRECISIONS and (self.tininess == "after" or not self.format.ftz)
 
     @property
     def dtype(self) -> type[np.floating]:
-        return np.float32 if self.precision in ("fp16", "fp32") else np.float64
+        return np.float32 if self.native and self.precision != "fp64" else np.float64
 
     @property
     def unit_roundoff(self) -> float:
@@ -88,6 +92,8 @@ class Arith:
     def label(self) -> str:
         if self.precision in ("fp32", "fp64"):
             return self.precision
+        if self.ftz and self.tininess == "before":
+            return f"{self.precision}-ftz-before"
         return f"{self.precision}-{'ftz' if self.ftz else 'ieee'}"
 
     def bits(self, value: float) -> tuple[int, int]:
@@ -112,7 +118,7 @@ class Arith:
     def round(self, x: np.ndarray | float) -> np.ndarray:
         """Round values (already in or above working precision) to the working format."""
         if not self.native:
-            return self.format.round(np.asarray(x, dtype=np.float64))
+            return self.format.round(np.asarray(x, dtype=np.float64), tininess=self.tininess)
         if self.precision != "fp16":
             return np.asarray(x, dtype=self.dtype)
         a = np.asarray(x)
@@ -130,31 +136,31 @@ class Arith:
 
     def add(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         if not self.native:
-            return ops.add(self.format, a, b)
+            return ops.add(self.format, a, b, tininess=self.tininess)
         with np.errstate(all="ignore"):
             return self.round(np.add(a, b, dtype=self.dtype))
 
     def sub(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         if not self.native:
-            return ops.sub(self.format, a, b)
+            return ops.sub(self.format, a, b, tininess=self.tininess)
         with np.errstate(all="ignore"):
             return self.round(np.subtract(a, b, dtype=self.dtype))
 
     def mul(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         if not self.native:
-            return ops.mul(self.format, a, b)
+            return ops.mul(self.format, a, b, tininess=self.tininess)
         with np.errstate(all="ignore"):
             return self.round(np.multiply(a, b, dtype=self.dtype))
 
     def div(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         if not self.native:
-            return ops.div(self.format, a, b)
+            return ops.div(self.format, a, b, tininess=self.tininess)
         with np.errstate(all="ignore"):
             return self.round(np.divide(a, b, dtype=self.dtype))
 
     def sqrt(self, a: np.ndarray) -> np.ndarray:
         if not self.native:
-            return ops.sqrt(self.format, a)
+            return ops.sqrt(self.format, a, tininess=self.tininess)
         with np.errstate(all="ignore"):
             return self.round(np.sqrt(np.asarray(a, dtype=self.dtype)))
 
@@ -214,6 +220,7 @@ def _round16_f32(a: np.ndarray, ftz: bool) -> np.ndarray:
     return r.view(np.float32)
 
 
-def make_arith(precision: Precision = "fp16", subnormals: Literal["ftz", "ieee"] = "ftz") -> Arith:
+def make_arith(precision: Precision = "fp16", subnormals: Literal["ftz", "ieee"] = "ftz",
+               tininess: Tininess = "after") -> Arith:
     """The arithmetic for a ``--precision`` / ``--subnormals`` pair (ValueError for a bad name)."""
-    return Arith(precision_name(precision), subnormals == "ftz")
+    return Arith(precision_name(precision), subnormals == "ftz", tininess)

@@ -14,11 +14,14 @@ import importlib.util
 import os
 from ctypes import POINTER, Structure, c_double, c_int32, c_int64, c_uint64, c_void_p
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import Rend3rError
-from ..precision.formats import FloatFormat
+
+if TYPE_CHECKING:
+    from .arith import Arith
 
 # Column layouts shared with csrc/kernels.h.
 SF_LOC, SF_ROT, SF_INV, SF_ZSIGN, SF_ONE, SF_SHAT, SF_C2, SF_COLUMNS = 0, 3, 7, 10, 11, 12, 15, 16
@@ -39,14 +42,14 @@ class Format(Structure):
     """A working format of the _fmt kernels (csrc/fformat.h)."""
 
     _fields_ = [("drop", c_int64), ("max_bits", c_uint64), ("min_normal_bits", c_uint64),
-                ("subnormal_magic", c_double), ("ftz", c_int32), ("wide", c_int32)]
+                ("subnormal_magic", c_double), ("ftz", c_int32), ("wide", c_int32), ("before", c_int32)]
 
     @classmethod
-    def of(cls, fmt: FloatFormat) -> Format:
-        bits = lambda x: int(np.float64(x).view(np.uint64))  # noqa: E731
+    def of(cls, ar: Arith) -> Format:
+        fmt, bits = ar.format, lambda x: int(np.float64(x).view(np.uint64))  # noqa: E731
         return cls(52 - fmt.frac_bits, bits(fmt.max), bits(fmt.min_normal),
                    float(np.ldexp(1.0, fmt.emin - fmt.frac_bits + 52)), int(fmt.ftz),
-                   int(fmt.frac_bits > 25 or fmt.exp_bits == 11))
+                   int(fmt.frac_bits > 25 or fmt.exp_bits == 11), int(ar.tininess == "before"))
 
 
 class Shapes(Structure):
@@ -161,10 +164,12 @@ def isa() -> str:
     return "avx2" if wanted == "avx2" and hasattr(lib, "nearest_f32_avx2") and lib.have_avx2() else "base"
 
 
-def kernel(name: str, precision: str, ftz: bool) -> ctypes._CFuncPtr:
+def kernel(name: str, ar: Arith) -> ctypes._CFuncPtr:
     """The kernel ``name`` compiled for a working precision and subnormal handling (any
-    format other than fp16, fp32 and fp64: the format kernels, given the format)."""
-    return getattr(library(), f"{name}_{SUFFIXES.get((precision, ftz), FORMAT)}_{isa()}")
+    other format, and fp16 judging tininess before rounding: the format kernels, given
+    the format)."""
+    suffix = SUFFIXES[ar.precision, ar.ftz] if ar.native else FORMAT
+    return getattr(library(), f"{name}_{suffix}_{isa()}")
 
 
 def round16(values: np.ndarray, ftz: bool) -> np.ndarray:

@@ -23,6 +23,7 @@ class EmuOptions:
 
     precision: Precision = "fp16"
     subnormals: Literal["ftz", "ieee"] = "ftz"
+    tininess: Literal["after", "before"] = "after"  # ftz: tiny judged after rounding, or before (a quirk)
     mode: Mode = "raytrace"
     width: int = 512
     height: int = 384
@@ -46,7 +47,7 @@ class EmuOptions:
 
     @property
     def arith(self) -> Arith:
-        return make_arith(self.precision, self.subnormals)
+        return make_arith(self.precision, self.subnormals, self.tininess)
 
     @property
     def pixels(self) -> int:

@@ -30,7 +30,7 @@ import numpy as np
 from ..isa import Table, lookup
 from ..isa.tables import PROP_LIMIT, SHAPE_TYPE_CODES
 from . import bounds, grids, native, threads
-from .arith import Arith
+from .arith import PRECISIONS, Arith
 from .camera import camera_rays
 from .frame import Frame
 from .lights import POINT, Light, lights_from_scene
@@ -77,7 +77,7 @@ class _Frame:
 
     def kernel(self, name: str):
         """The compiled kernel ``name`` for this frame's precision."""
-        return native.kernel(name, self.ar.precision, self.ar.ftz)
+        return native.kernel(name, self.ar)
 
 
 def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
@@ -121,14 +121,14 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     cam[native.CAM_TMIN], cam[native.CAM_TMAX], cam[native.CAM_Z] = rays.tmin, rays.tmax, rays.z
     if rays.rotation is not None:  # the kernel turns (x[col], y[row], z) per pixel
         cam[native.CAM_ROT:native.CAM_ROT + 4] = [np.asarray(c, dtype) for c in rays.rotation]
-    fmt = None if ar.native else pointer(native.Format.of(ar.format))
+    fmt = None if ar.native else pointer(native.Format.of(ar))
     sf, si, bnd, bounded, index = _shape_tables(scene, ar, fmt)
     lights = lights_from_scene(scene, ar, options.light_model)
     n = len(sf)
     view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
                          native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny, fmt)
     if n:
-        native.kernel("origin_terms", ar.precision, ar.ftz)(byref(view), native.ptr(cam, dtype, (native.CAM_COLUMNS,)))
+        native.kernel("origin_terms", ar)(byref(view), native.ptr(cam, dtype, (native.CAM_COLUMNS,)))
     return _Frame(ar, dtype, cam, np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype),
                   rays.rotation is not None, sf, si, index, bnd, bounded, lights,
                   _light_rows(lights, dtype), options.jobs or threads.available_cores(), view)
@@ -156,10 +156,10 @@ def _shape_tables(scene: Scene, ar: Arith, fmt) -> tuple[np.ndarray, ...]:
     bnd = np.empty((rows, native.B_COLUMNS))
     bounded = np.empty(rows, np.uint8)
     out = np.empty(rows, np.int32)
-    n = native.kernel("shape_tables", ar.precision, ar.ftz)(
+    n = native.kernel("shape_tables", ar)(
         native.ptr(values, np.uint16, (rows, PROP_LIMIT)), index.ctypes.data, rows, _SHAPE_PROPS.ctypes.data,
         _KINDS.ctypes.data, sf.ctypes.data, si.ctypes.data, bnd.ctypes.data, bounded.ctypes.data, out.ctypes.data, fmt)
-    if not (ar.native or ar.format.exp_bits >= 8):
+    if not (ar.precision in PRECISIONS or ar.format.exp_bits >= 8):
         bounded[:] = 0
     return sf[:n], si[:n], bnd[:n], bounded[:n].astype(bool), out[:n]
 

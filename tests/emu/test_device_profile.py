@@ -8,7 +8,7 @@ import pytest
 
 from rend3r.emu.lighting import fixed_intensity
 from rend3r.emu.options import EmuOptions
-from rend3r.emu.quirks import PROFILES, QUIRKS, apply_quirks, contradictions, quirk_names
+from rend3r.emu.quirks import PROFILES, QUIRKS, UNSURE, apply_quirks, contradictions, quirk_names
 from rend3r.emu.run import run_program
 from rend3r.errors import Rend3rError
 from rend3r.isa import ShapeSet, Table, encode, lookup
@@ -42,11 +42,12 @@ def test_every_quirk_is_documented_and_sets_real_options():
     for name, q in QUIRKS.items():
         assert re.search(rf"^\| `{re.escape(name)}` \|", doc, re.M), name
         assert q.changes and all(f in fields for f, _ in q.changes), name
-    assert set(PROFILES["rend3r-2022"]) == set(QUIRKS)
+    assert set(PROFILES["rend3r-2022"]) == set(QUIRKS) - set(UNSURE)  # the guesses stay out of the profile
 
 
 def test_profile_and_quirk_selection():
-    assert quirk_names("rend3r-2022", []) == list(QUIRKS)
+    assert quirk_names("rend3r-2022", []) == [q for q in QUIRKS if q not in UNSURE]
+    assert "tiny-before-rounding" in quirk_names("rend3r-2022", ["tiny-before-rounding"])  # profile + a guess
     assert quirk_names(None, ["lr-to-1", "device-camera"]) == ["device-camera", "lr-to-1"]
     with pytest.raises(Rend3rError, match="unknown device quirk 'nope'"):
         quirk_names(None, ["nope"])

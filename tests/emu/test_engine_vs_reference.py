@@ -171,6 +171,14 @@ def test_random_scenes_in_other_formats(cam, lights, shapes, ties, fmt):
     check(program(cam, lights, shapes, ties, options), options)
 
 
+@settings(max_examples=40, derandomize=True)
+@given(*scene_args[:-1])
+def test_random_scenes_judging_tininess_before_rounding(cam, lights, shapes, ties):
+    """fp16 with the tiny-before-rounding quirk runs on the format kernels."""
+    options = EmuOptions(precision="fp16", subnormals="ftz", tininess="before", width=24, height=18)
+    check(program(cam, lights, shapes, ties, options), options)
+
+
 @settings(max_examples=100, derandomize=True)
 @given(camera, st.lists(light, min_size=1, max_size=3).filter(lambda ls: ls[0]["src"] == 1),
        *scene_args[2:], st.booleans())

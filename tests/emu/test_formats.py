@@ -72,3 +72,24 @@ def test_the_command_line_takes_formats(tmp_path):
     assert values and all(len(r["hex"]) == 6 for r in values)  # 0x + four digits: 16-bit bf16
     bad = CliRunner().invoke(main, ["emulate", str(src), "-o", str(out), "--precision", "e1m3"])
     assert bad.exit_code == 2 and "exponent bits 1" in bad.output
+
+
+def test_tininess_before_rounding_flushes_the_boundary():
+    """(2^-7 - 2^-18) * 2^-7 = 2^-14 - 2^-25: rounds up to 2^-14 (0400) judged after rounding,
+    flushes (0000) judged before, the device quirk tiny-before-rounding."""
+    a, b = 2.0**-7 - 2.0**-18, 2.0**-7
+    after, before = make_arith("fp16", "ftz"), make_arith("fp16", "ftz", "before")
+    assert after.bits(after.mul(after.const(a), after.const(b)))[0] == 0x0400
+    assert before.bits(before.mul(before.const(a), before.const(b)))[0] == 0x0000
+    assert after.native and not before.native and make_arith("fp16", "ieee", "before").native
+
+
+def test_the_quirk_is_named_but_not_in_the_profile(tmp_path):
+    from rend3r.emu.quirks import PROFILES, QUIRKS
+
+    assert "tiny-before-rounding" in QUIRKS and "tiny-before-rounding" not in PROFILES["rend3r-2022"]
+    src = tmp_path / "s.asm"
+    src.write_text(ONE_SPHERE)
+    run = CliRunner().invoke(main, ["emulate", str(src), "-o", str(tmp_path / "s.png"), "--size", "32x24",
+                                    "--device-quirk", "tiny-before-rounding"])
+    assert run.exit_code == 0, run.output

@@ -12,7 +12,8 @@
  * correctly in the normal range. Results below the smallest normal number are rounded to
  * the subnormal grid by adding and subtracting a power of two; ftz then flushes what is
  * still below it (so values that round up to the smallest normal number keep it, as in
- * the fp16 kernels and rend3r/precision/rounding.py).
+ * the fp16 kernels and rend3r/precision/rounding.py), or, judging tininess before
+ * rounding (Format.before), what was below it before rounding.
  *
  * The format is a kernel argument (Shapes.format, shape_tables' last argument): each
  * kernel copies it to a thread-local at entry (FORMAT_ENTER), where R reads it.
@@ -43,8 +44,8 @@ static inline f64x4 round_format4(f64x4 x)
     r = SEL_BITS((u64x4)((i64x4)(r & ~F64_SIGN) > (int64_t)f->max_bits), sign | F64_INF, r);
     f64x4 m = (f64x4)a, magic = (f64x4){0} + f->subnormal_magic;  /* below 2**emin: the subnormal grid */
     r = SEL_BITS((u64x4)((i64x4)a < (int64_t)f->min_normal_bits), (u64x4)((m + magic) - magic) | sign, r);
-    if (f->ftz)  /* what the grid left below 2**emin */
-        r = SEL_BITS((u64x4)((i64x4)(r & ~F64_SIGN) < (int64_t)f->min_normal_bits), sign, r);
+    if (f->ftz)  /* what the grid left below 2**emin (before: what was below it unrounded) */
+        r = SEL_BITS((u64x4)((i64x4)(f->before ? a : r & ~F64_SIGN) < (int64_t)f->min_normal_bits), sign, r);
     return (f64x4)SEL_BITS((u64x4)((i64x4)a > (int64_t)F64_INF), b, r);
 }
 

@@ -50,6 +50,7 @@ typedef struct {
     double subnormal_magic; /* 2**(emin - M + 52): adding and subtracting it rounds to the subnormal grid */
     int32_t ftz;            /* flush results below 2**emin to zero */
     int32_t wide;           /* M > 25: double rounding is not innocuous, round to odd first */
+    int32_t before;         /* ftz judges a result tiny before rounding (a device quirk) */
 } Format;
 
 typedef struct {

@@ -1,0 +1,195 @@
+"""Operation counts of the emulator's datapaths, taken from the emulator's own code.
+
+The count runs the datapath itself on a 1x1 frame with one shape (or one triangle) and
+one point light, through an :class:`~rend3r.emu.arith.Arith` that counts its calls. Each
+call on arrays is one hardware unit of a fully pipelined datapath (every operation of
+``docs/emulator.md`` section 4 its own adder, multiplier, divider or square root), so the
+counts are the units such a datapath instantiates: for the raytracer, one ray against one
+shape, then per light the lighting and one shadow test; for the rasterizer, one
+triangle's set-up and one pixel. A datapath that shares units between steps (the device
+reuses none) needs fewer. Rotations use a quaternion that is not the identity, so the
+emulator's identity short cut (``vec.rotate_inverse``) does not skip their units;
+negation (a sign flip) and comparisons are not counted.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections import Counter
+from dataclasses import dataclass, field
+from functools import cache
+
+import numpy as np
+
+from .cost import OperatorCost, operator_cost
+from .formats import FloatFormat
+
+#: The operators counted, as :func:`rend3r.precision.cost.operator_cost` names them
+#: (subtraction is counted as an adder).
+COUNTED = ("add", "mul", "div", "sqrt")
+
+#: Raytracer stages: the emulator function a call is made in -> stage name. A call inside
+#: a shadow test or the lighting belongs there, whatever it calls.
+_RAY_STAGES = {
+    "camera_rays": "camera", "to_object": "intersect", "origin_term": "intersect", "solve": "intersect",
+    "squared_distance": "distance", "render_reference": "distance",  # |d|^2 is computed in the caller
+    "surface": "surface", "diffuse": "lighting", "_blocked": "shadow",
+}
+_OUTER = ("_blocked", "diffuse")  # stages that contain calls of others
+
+_RAY_SCENE = """
+nr
+cam rrot, irot, 1, 0.125
+lt 0, src, 2
+lt 0, xloc, yloc, 2, 2
+lt 0, zloc, 1
+lt 0, col, 0xFFFF
+lt 0, int, 1
+sp 0, type, col, 1, 0xFFFF
+sp 0, xloc, yloc, 0, 0
+sp 0, zloc, rrot, -4, 1
+sp 0, irot, jrot, 0.25, 0.125
+sp 0, xscl, yscl, 1, 1
+sp 0, zscl, mat, 1, 0
+nf
+er
+er
+"""
+
+_RASTER_SCENE = """
+nr
+cam rrot, 1
+lt 0, src, 2
+lt 0, xloc, yloc, 0, 0
+lt 0, zloc, 1
+lt 0, col, 0xFFFF
+lt 0, int, 1
+tr 0, x1, y1, -1, -1
+tr 0, z1, x2, -4, 1
+tr 0, y2, z2, -1, -4
+tr 0, x3, y3, 0, 1
+tr 0, z3, col, -4, 0xFFFF
+nf
+er
+er
+"""
+
+
+@dataclass(frozen=True)
+class OperationCounts:
+    """Units of each operator in one datapath, in total and per stage."""
+
+    total: dict[str, int]
+    stages: dict[str, dict[str, int]]
+
+    def cost(self, fmt: FloatFormat) -> OperatorCost:
+        """The datapath's units in ``fmt``: LUT, FF and DSP summed over every unit; latency
+        summed too (an upper bound on the longest chain, not the chain itself)."""
+        parts = [(n, operator_cost(op, fmt)) for op, n in self.total.items()]
+        return OperatorCost(*(sum(n * getattr(c, f) for n, c in parts) for f in ("latency", "lut", "ff", "dsp")))
+
+
+def _counting_arith():
+    """An Arith (fp64) that counts its add/sub/mul/div/sqrt calls per operator and stage."""
+    from ..emu.arith import Arith
+
+    @dataclass(frozen=True)
+    class CountingArith(Arith):
+        counts: Counter = field(default_factory=Counter, compare=False)
+
+        def _count(self, op: str) -> None:
+            self.counts[(_stage(), op)] += 1
+
+        def add(self, a, b):
+            self._count("add")
+            return super().add(a, b)
+
+        def sub(self, a, b):
+            self._count("add")
+            return super().sub(a, b)
+
+        def mul(self, a, b):
+            self._count("mul")
+            return super().mul(a, b)
+
+        def div(self, a, b):
+            self._count("div")
+            return super().div(a, b)
+
+        def sqrt(self, a):
+            self._count("sqrt")
+            return super().sqrt(a)
+
+    return CountingArith("fp64", False)
+
+
+def _stage() -> str:
+    """The stage of the datapath the current Arith call is made in: the outer stage
+    (shadow, lighting) if the call is inside one, else the innermost named function of
+    :data:`_RAY_STAGES`, else the innermost function of the rasterizer's modules."""
+    frame = sys._getframe(3)  # the caller of the counting method's caller
+    inner, raster = None, None
+    while frame is not None:
+        name = frame.f_code.co_name
+        if name in _OUTER:
+            return _RAY_STAGES[name]
+        if inner is None and name in _RAY_STAGES:
+            inner = _RAY_STAGES[name]
+        module = frame.f_globals.get("__name__", "")
+        if raster is None and module.startswith("rend3r.emu.raster") and not name.startswith("<"):
+            raster = name.lstrip("_")
+        frame = frame.f_back
+    return inner or raster or "scene"
+
+
+def _scene(source: str):
+    from ..asm.assembler import assemble_source
+    from ..emu.options import EmuOptions
+    from ..emu.run import run_program
+
+    words = list(assemble_source(source, "<datapath>").program.words)
+    scenes = []
+    run_program(words, EmuOptions(precision="fp64", width=1, height=1), on_scene=lambda s, n: scenes.append(s),
+                keep_frames=False)
+    return scenes[0]
+
+
+def _count(render, source: str, mode: str) -> OperationCounts:
+    from ..emu.options import EmuOptions
+
+    ar = _counting_arith()
+
+    @dataclass(frozen=True)
+    class CountingOptions(EmuOptions):
+        @property
+        def arith(self):
+            return ar
+
+    frame = render(_scene(source), CountingOptions(precision="fp64", mode=mode, width=1, height=1))
+    if isinstance(frame, tuple):
+        frame = frame[0]
+    if int(np.asarray(frame.provenance).ravel()[0]) < 0:
+        raise AssertionError(f"the {mode} counting scene missed its shape")
+    total: Counter = Counter()
+    stages: dict[str, Counter] = {}
+    for (stage, op), n in ar.counts.items():
+        total[op] += n
+        stages.setdefault(stage, Counter())[op] += n
+    order = lambda c: {op: c[op] for op in COUNTED if c[op]}  # noqa: E731
+    return OperationCounts(order(total), {s: order(c) for s, c in stages.items()})
+
+
+@cache
+def raytrace_counts() -> OperationCounts:
+    """Units of the raytracer: one ray, one shape, one point light with its shadow test."""
+    from ..emu.reference import render_reference
+
+    return _count(render_reference, _RAY_SCENE, "raytrace")
+
+
+@cache
+def raster_counts() -> OperationCounts:
+    """Units of the rasterizer: one triangle, one pixel, one point light."""
+    from ..emu.raster import render_frame
+
+    return _count(render_frame, _RASTER_SCENE, "raster")

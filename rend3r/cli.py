@@ -30,6 +30,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "disasm": ("rend3r.asm.cli_disasm:disasm_command", "Disassemble a memory image (mem, bin, coe, ihex, lst) to source."),
     "render-all": ("rend3r.golden.render_all:render_all_command", "Render every example program to PNGs in a folder."),
     "trace-diff": ("rend3r.emu.trace_diff:trace_diff_command", "Compare two float16 pixel traces; report the first divergence."),
+    "explore": ("rend3r.explore.cli:explore_command", "Which uniform number format each program needs, and its hardware cost."),
     "svo": ("rend3r.svo.cli:svo_group", "Sparse voxel octrees: build from meshes, trace in 16.16 fixed point, sweep cache/core designs."),
 }
 

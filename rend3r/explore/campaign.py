@@ -1,0 +1,111 @@
+"""The tasks of an exploration campaign, each a pure function of plain values.
+
+A task renders one program in one format (:func:`render_design`), another scores a
+rendering against the fp64 one (:func:`score_design`), and :func:`design_cost` costs a
+format. Inputs are program words and options, outputs plain dataclasses of numbers, so a
+distributed runner can ship them to workers as they are.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: The reference every design is scored against.
+REFERENCE = "fp64"
+
+
+@dataclass(frozen=True)
+class ProgramSpec:
+    """A loaded program: its words, the mode it renders in and the frames to render."""
+
+    name: str
+    words: tuple[int, ...]
+    mode: str
+    frames: int
+
+
+@dataclass(frozen=True)
+class Rendering:
+    """One program rendered in one format: every frame's RGB565 and provenance, stacked."""
+
+    rgb565: np.ndarray  # (frames * H, W) uint16
+    provenance: np.ndarray  # (frames * H, W) int32, -1 = miss
+
+
+@dataclass(frozen=True)
+class Score:
+    """How far a design's rendering is from the fp64 one."""
+
+    psnr: float  # dB over every channel of every frame; inf when identical
+    max_channel: int  # largest channel difference, 0..255 (RGB888)
+    differing: float  # share of pixels with any channel different
+    provenance: float  # share of pixels whose nearest shape differs (or hit against miss)
+    interior_provenance: float  # the same share among pixels off every silhouette of fp64
+
+
+@dataclass(frozen=True)
+class DesignCost:
+    """The units of the raytrace and raster datapaths in one format, summed."""
+
+    lut: int
+    ff: int
+    dsp: int
+
+    @property
+    def key(self) -> tuple[int, int, int]:
+        """Ranking: fewer LUTs first, then DSP48E1 slices, then flip-flops."""
+        return self.lut, self.dsp, self.ff
+
+
+def render_design(program: ProgramSpec, precision: str, subnormals: str, width: int, height: int,
+                  jobs: int = 0) -> Rendering:
+    """Render ``program`` with ``precision`` as the working format of every operation."""
+    from ..emu import EmuOptions, run_program
+    from ..errors import Rend3rError
+
+    options = EmuOptions(precision=precision, subnormals=subnormals, mode=program.mode, width=width,
+                         height=height, jobs=jobs)
+    frames = run_program(list(program.words), options=options, frames=program.frames).frames
+    if not frames:
+        raise Rend3rError(f"{program.name}: rendered no frame (no nf before the program ends)")
+    return Rendering(np.concatenate([f.rgb565 for f in frames]), np.concatenate([f.provenance for f in frames]))
+
+
+def score_design(reference: Rendering, design: Rendering) -> Score:
+    """Colour and nearest-shape differences of ``design`` against ``reference``."""
+    from ..golden.metrics import image_metrics, interior_mask
+
+    colour = image_metrics(reference.rgb565, design.rgb565)
+    differs = reference.provenance != design.provenance
+    interior = interior_mask(reference.provenance)
+    inside = int(interior.sum())
+    return Score(
+        psnr=colour.psnr, max_channel=colour.max_channel, differing=colour.share_differing,
+        provenance=float(differs.mean()),
+        interior_provenance=float(differs[interior].sum() / inside) if inside else 0.0,
+    )
+
+
+def design_cost(precision: str) -> DesignCost:
+    """Modelled cost of a device whose raytrace and raster datapaths both work in ``precision``
+    (:mod:`rend3r.precision.datapath` counts, :mod:`rend3r.precision.cost` per unit)."""
+    from ..precision.datapath import raster_counts, raytrace_counts
+    from ..precision.formats import parse
+
+    fmt = parse(precision)
+    ray, raster = raytrace_counts().cost(fmt), raster_counts().cost(fmt)
+    return DesignCost(ray.lut + raster.lut, ray.ff + raster.ff, ray.dsp + raster.dsp)
+
+
+def cheapest(scores: dict[str, Score], costs: dict[str, DesignCost], min_psnr: float) -> str | None:
+    """The cheapest format whose PSNR is at least ``min_psnr``; None when none is."""
+    meeting = [f for f, s in scores.items() if s.psnr >= min_psnr]
+    return min(meeting, key=lambda f: costs[f].key) if meeting else None
+
+
+def worst_psnr(scores: list[Score]) -> float:
+    """The lowest PSNR of a format over the programs (inf when every one is identical)."""
+    return min((s.psnr for s in scores), default=math.inf)

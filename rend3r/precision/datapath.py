@@ -175,7 +175,7 @@ def _count(render, source: str, mode: str) -> OperationCounts:
     for (stage, op), n in ar.counts.items():
         total[op] += n
         stages.setdefault(stage, Counter())[op] += n
-    order = lambda c: {op: c[op] for op in COUNTED if c[op]}  # noqa: E731
+    order = lambda c: {op: c[op] for op in COUNTED if c[op]}
     return OperationCounts(order(total), {s: order(c) for s, c in stages.items()})
 
 

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..precision.datapath import Resources
+
 #: The reference every design is scored against.
 REFERENCE = "fp64"
 
@@ -46,27 +48,13 @@ class Score:
     interior_provenance: float  # the same share among pixels off every silhouette of fp64
 
 
-@dataclass(frozen=True)
-class DesignCost:
-    """The units of the raytrace and raster datapaths in one format, summed."""
-
-    lut: int
-    ff: int
-    dsp: int
-
-    @property
-    def key(self) -> tuple[int, int, int]:
-        """Ranking: fewer LUTs first, then DSP48E1 slices, then flip-flops."""
-        return self.lut, self.dsp, self.ff
-
-
 def render_design(program: ProgramSpec, precision: str, subnormals: str, width: int, height: int,
                   jobs: int = 0) -> Rendering:
     """Render ``program`` with ``precision`` as the working format of every operation."""
     from ..emu import EmuOptions, run_program
     from ..errors import Rend3rError
 
-    options = EmuOptions(precision=precision, subnormals=subnormals, mode=program.mode, width=width,
+    options = EmuOptions(precision=precision, subnormals=subnormals, mode=program.mode, width=width,  # type: ignore[arg-type]
                          height=height, jobs=jobs)
     frames = run_program(list(program.words), options=options, frames=program.frames).frames
     if not frames:
@@ -89,18 +77,17 @@ def score_design(reference: Rendering, design: Rendering) -> Score:
     )
 
 
-def design_cost(precision: str) -> DesignCost:
+def design_cost(precision: str) -> Resources:
     """Modelled cost of a device whose raytrace and raster datapaths both work in ``precision``
     (:mod:`rend3r.precision.datapath` counts, :mod:`rend3r.precision.cost` per unit)."""
     from ..precision.datapath import raster_counts, raytrace_counts
     from ..precision.formats import parse
 
     fmt = parse(precision)
-    ray, raster = raytrace_counts().cost(fmt), raster_counts().cost(fmt)
-    return DesignCost(ray.lut + raster.lut, ray.ff + raster.ff, ray.dsp + raster.dsp)
+    return raytrace_counts().cost(fmt) + raster_counts().cost(fmt)
 
 
-def cheapest(scores: dict[str, Score], costs: dict[str, DesignCost], min_psnr: float) -> str | None:
+def cheapest(scores: dict[str, Score], costs: dict[str, Resources], min_psnr: float) -> str | None:
     """The cheapest format whose PSNR is at least ``min_psnr``; None when none is."""
     meeting = [f for f, s in scores.items() if s.psnr >= min_psnr]
     return min(meeting, key=lambda f: costs[f].key) if meeting else None

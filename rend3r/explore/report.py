@@ -9,7 +9,8 @@ import math
 from dataclasses import dataclass
 from xml.sax.saxutils import escape
 
-from .campaign import DesignCost, ProgramSpec, Score, cheapest, worst_psnr
+from ..precision.datapath import Resources
+from .campaign import ProgramSpec, Score, cheapest, worst_psnr
 
 COLUMNS = ("program", "mode", "frames", "format", "subnormals", "psnr_db", "max_channel", "differing_share",
            "provenance_share", "interior_provenance_share", "lut", "ff", "dsp", "meets_min_psnr")
@@ -22,7 +23,7 @@ class Results:
     programs: list[ProgramSpec]
     formats: list[str]
     scores: dict[tuple[str, str], Score]  # (program name, format) -> score against fp64
-    costs: dict[str, DesignCost]
+    costs: dict[str, Resources]
     min_psnr: float
     subnormals: str
     size: tuple[int, int]
@@ -52,7 +53,7 @@ def results_csv(r: Results) -> bytes:
     return out.getvalue().encode()
 
 
-def pareto_front(points: dict[str, tuple[DesignCost, float]]) -> list[str]:
+def pareto_front(points: dict[str, tuple[Resources, float]]) -> list[str]:
     """The formats no other format beats in both cost and worst PSNR, cheapest first."""
     front: list[str] = []
     for f in sorted(points, key=lambda f: (points[f][0].key, -points[f][1])):
@@ -101,10 +102,10 @@ def pareto_svg(r: Results) -> bytes:
     front = pareto_front(points)
     line = " ".join(f"{x(points[f][0].lut):.1f},{y(points[f][1]):.1f}" for f in front)
     parts.append(f'<polyline points="{line}" fill="none" stroke="steelblue" stroke-width="2"/>')
-    for f, (c, v) in points.items():
+    for f, (c, psnr) in points.items():
         colour = "steelblue" if f in front else "grey"
-        parts.append(f'<circle cx="{x(c.lut):.1f}" cy="{y(v):.1f}" r="4" fill="{colour}"/>')
-        parts.append(f'<text x="{x(c.lut) + 6:.1f}" y="{y(v) - 6:.1f}">{escape(f)}</text>')
+        parts.append(f'<circle cx="{x(c.lut):.1f}" cy="{y(psnr):.1f}" r="4" fill="{colour}"/>')
+        parts.append(f'<text x="{x(c.lut) + 6:.1f}" y="{y(psnr) - 6:.1f}">{escape(f)}</text>')
     parts.append("</svg>\n")
     return "\n".join(parts).encode()
 
@@ -121,10 +122,10 @@ def summary_md(r: Results, command: str) -> bytes:
              "| program | mode | cheapest meeting the bound | " + " | ".join(f"{f} PSNR" for f in r.formats) + " |",
              "|---|---|---|" + "---:|" * len(r.formats)]
     for p in r.programs:
-        scores = r.of_program(p)
-        best = cheapest(scores, r.costs, r.min_psnr)
+        by_format = r.of_program(p)
+        best = cheapest(by_format, r.costs, r.min_psnr)
         lines.append(f"| {p.name} | {p.mode} | {best or 'none'} | "
-                     + " | ".join(_db(scores[f].psnr) for f in r.formats) + " |")
+                     + " | ".join(_db(by_format[f].psnr) for f in r.formats) + " |")
     lines += ["", "| format | LUT | FF | DSP48E1 | worst PSNR (dB) | programs meeting the bound |",
               "|---|---:|---:|---:|---:|---:|"]
     for f in r.formats:

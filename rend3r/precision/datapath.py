@@ -18,11 +18,16 @@ import sys
 from collections import Counter
 from dataclasses import dataclass, field
 from functools import cache
+from types import FrameType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .cost import OperatorCost, operator_cost
+from .cost import operator_cost
 from .formats import FloatFormat
+
+if TYPE_CHECKING:
+    from ..emu.options import Mode
 
 #: The operators counted, as :func:`rend3r.precision.cost.operator_cost` names them
 #: (subtraction is counted as an adder).
@@ -76,17 +81,33 @@ er
 
 
 @dataclass(frozen=True)
+class Resources:
+    """FPGA resources of a set of units: LUTs, flip-flops and DSP48E1 slices."""
+
+    lut: int
+    ff: int
+    dsp: int
+
+    def __add__(self, other: Resources) -> Resources:
+        return Resources(self.lut + other.lut, self.ff + other.ff, self.dsp + other.dsp)
+
+    @property
+    def key(self) -> tuple[int, int, int]:
+        """Ranking: fewer LUTs first, then DSP48E1 slices, then flip-flops."""
+        return self.lut, self.dsp, self.ff
+
+
+@dataclass(frozen=True)
 class OperationCounts:
     """Units of each operator in one datapath, in total and per stage."""
 
     total: dict[str, int]
     stages: dict[str, dict[str, int]]
 
-    def cost(self, fmt: FloatFormat) -> OperatorCost:
-        """The datapath's units in ``fmt``: LUT, FF and DSP summed over every unit; latency
-        summed too (an upper bound on the longest chain, not the chain itself)."""
+    def cost(self, fmt: FloatFormat) -> Resources:
+        """The datapath's units in ``fmt``: each unit's modelled LUT, FF and DSP, summed."""
         parts = [(n, operator_cost(op, fmt)) for op, n in self.total.items()]
-        return OperatorCost(*(sum(n * getattr(c, f) for n, c in parts) for f in ("latency", "lut", "ff", "dsp")))
+        return Resources(*(sum(n * getattr(c, f) for n, c in parts) for f in ("lut", "ff", "dsp")))
 
 
 def _counting_arith():
@@ -127,7 +148,7 @@ def _stage() -> str:
     """The stage of the datapath the current Arith call is made in: the outer stage
     (shadow, lighting) if the call is inside one, else the innermost named function of
     :data:`_RAY_STAGES`, else the innermost function of the rasterizer's modules."""
-    frame = sys._getframe(3)  # the caller of the counting method's caller
+    frame: FrameType | None = sys._getframe(3)  # the caller of the counting method's caller
     inner, raster = None, None
     while frame is not None:
         name = frame.f_code.co_name
@@ -154,7 +175,7 @@ def _scene(source: str):
     return scenes[0]
 
 
-def _count(render, source: str, mode: str) -> OperationCounts:
+def _count(render, source: str, mode: Mode) -> OperationCounts:
     from ..emu.options import EmuOptions
 
     ar = _counting_arith()

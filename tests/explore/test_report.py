@@ -2,16 +2,17 @@
 
 import math
 
-from rend3r.explore.campaign import DesignCost, Score, cheapest, design_cost
+from rend3r.explore.campaign import Score, cheapest, design_cost
 from rend3r.explore.report import pareto_front
+from rend3r.precision.datapath import Resources
 
 
 def score(psnr: float) -> Score:
     return Score(psnr, 0, 0.0, 0.0, 0.0)
 
 
-COSTS = {"a": DesignCost(100, 10, 1), "b": DesignCost(200, 10, 1), "c": DesignCost(300, 10, 1),
-         "d": DesignCost(400, 10, 2)}
+COSTS = {"a": Resources(100, 10, 1), "b": Resources(200, 10, 1), "c": Resources(300, 10, 1),
+         "d": Resources(400, 10, 2)}
 
 
 def test_front_drops_dominated_formats():

@@ -6,8 +6,7 @@ call on arrays is one hardware unit of a fully pipelined datapath (every operati
 ``docs/emulator.md`` section 4 its own adder, multiplier, divider or square root), so the
 counts are the units such a datapath instantiates: for the raytracer, one ray against one
 shape, then per light the lighting and one shadow test; for the rasterizer, one
-triangle's set-up and one pixel. A datapath that shares units between steps (the device
-reuses none) needs fewer. Rotations use a quaternion that is not the identity, so the
+triangle's set-up and one pixel. A datapath that shares units between steps needs fewer. Rotations use a quaternion that is not the identity, so the
 emulator's identity short cut (``vec.rotate_inverse``) does not skip their units;
 negation (a sign flip) and comparisons are not counted.
 """

@@ -198,7 +198,7 @@ class Sender:
         except ValueError:
             raise SendError(f"the device refused {FrameType(p.frame.type).name} with unknown "
                             f"code {reply.code}") from None
-        if code == Nack.TOO_LARGE:
+        if code == Nack.TOO_LARGE and p.frame.type == FrameType.BEGIN:  # to any other request: a mismatch
             limit = LIMIT.unpack(reply.payload)[0] if len(reply.payload) == LIMIT.size else "?"
             words = PROGRAM_INFO.unpack(p.frame.payload)[0]
             raise SendError(f"the device refuses a program of {words} words: its limit is {limit}")

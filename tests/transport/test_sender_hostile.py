@@ -1,0 +1,79 @@
+"""``rend3r send`` against a hostile device: fixed scenarios of ``fuzz/sender.py``.
+
+Each runs the real command over ``socket://`` to a device on loopback whose replies are
+hostile, and checks the verdict the long fuzz run checks: exit 0 when the exchange still
+completes, exit 1 with an ``error:`` naming the problem otherwise, never a traceback, a
+signal or a hang, and a small peak RSS.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import pytest
+
+from rend3r.transport.device import DeviceCore
+from rend3r.transport.links import DirectLink
+from rend3r.transport.protocol import FrameType, Nack, decode
+from rend3r.transport.session import Sender, SendError
+
+_spec = importlib.util.spec_from_file_location(
+    "fuzz_sender", Path(__file__).resolve().parents[2] / "fuzz" / "sender.py")
+hostile = sys.modules[_spec.name] = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(hostile)
+
+SCENARIOS = [
+    # behaviour, words, --timeout, --retries, what stderr must say
+    ("honest", 700, 0.5, 2, "loaded 700 words"),
+    ("phantom-acks", 700, 0.5, 2, "loaded 700 words"),
+    ("dup-reorder", 700, 0.5, 2, "loaded 700 words"),
+    ("trickle", 300, 3.0, 1, "loaded 300 words"),
+    ("silence", 700, 0.1, 2, "error: no acknowledgement for BEGIN after 3 tries"),
+    ("stall", 700, 0.1, 1, "error: no acknowledgement for BEGIN after 2 tries"),
+    ("close", 700, 0.1, 2, "the link failed"),
+    ("status-lies", 700, 0.5, 2, "error: the device"),
+    ("too-large", 700, 0.5, 2, "error: the device refused DATA: TOO_LARGE"),
+    ("fields", 700, 0.05, 1, ""),
+    ("garbage", 700, 0.05, 1, ""),
+    ("nack-storm", 700, 0.05, 1, ""),
+    ("mixed", 3000, 0.05, 3, ""),
+]
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize("behaviour, words, timeout, retries, says", SCENARIOS)
+def test_send_against_a_hostile_device(tmp_path, behaviour, words, timeout, retries, says):
+    case = hostile.Case(behaviour, seed=5, words=words, timeout=timeout, retries=retries, run=True)
+    result = hostile.run_sender(case, tmp_path)
+    assert result.ok and not result.timed_out, result.stderr
+    assert result.returncode in hostile.BEHAVIOURS[behaviour], result.stderr
+    assert result.returncode == 0 or "rend3r: error: " in result.stderr, result.stderr
+    assert says in result.stderr
+    assert result.seconds < case.bound
+    assert result.rss_bytes < 200 << 20
+
+
+@pytest.mark.parametrize("request_type", [FrameType.DATA, FrameType.COMMIT, FrameType.STATUS])
+def test_too_large_for_a_frame_that_is_not_begin_is_refused_by_name(request_type):
+    """TOO_LARGE answers BEGIN; for any other request it is a protocol mismatch, not a crash."""
+    core = DeviceCore()
+
+    def handle(data: bytes) -> bytes | None:
+        request = decode(data)
+        if request.type == request_type:
+            return request.reply(False, Nack.TOO_LARGE).encode()
+        return core.handle(data)
+
+    sender = Sender(DirectLink(handle), timeout=0.1, retries=1)
+    with pytest.raises(SendError, match=f"refused {request_type.name}: TOO_LARGE"):
+        sender.load(list(range(300)))
+        sender.status()
+
+
+def test_too_large_for_begin_names_the_limit():
+    sender = Sender(DirectLink(lambda data: decode(data).reply(False, Nack.TOO_LARGE, b"\0\0\1\0").encode()),
+                    timeout=0.1, retries=1)
+    with pytest.raises(SendError, match="refuses a program of 300 words: its limit is 256"):
+        sender.load(list(range(300)))

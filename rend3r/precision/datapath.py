@@ -35,7 +35,7 @@ COUNTED = ("add", "mul", "div", "sqrt")
 #: Raytracer stages: the emulator function a call is made in -> stage name. A call inside
 #: a shadow test or the lighting belongs there, whatever it calls.
 _RAY_STAGES = {
-    "camera_rays": "camera", "to_object": "intersect", "origin_term": "intersect", "solve": "intersect",
+    "camera_rays": "camera", "direction": "camera", "to_object": "intersect", "origin_term": "intersect", "solve": "intersect",
     "squared_distance": "distance", "render_reference": "distance",  # |d|^2 is computed in the caller
     "surface": "surface", "diffuse": "lighting", "_blocked": "shadow",
 }
@@ -43,9 +43,11 @@ _OUTER = ("_blocked", "diffuse")  # stages that contain calls of others
 
 _RAY_SCENE = """
 nr
-cam rrot, irot, 1, 0.125
+cam rrot, 1
+cam irot, 0.03125
 lt 0, src, 2
-lt 0, xloc, yloc, 2, 2
+lt 0, xloc, 2
+lt 0, yloc, 2
 lt 0, zloc, 1
 lt 0, col, 0xFFFF
 lt 0, int, 1
@@ -63,8 +65,8 @@ er
 _RASTER_SCENE = """
 nr
 cam rrot, 1
+cam irot, 0.03125
 lt 0, src, 2
-lt 0, xloc, yloc, 0, 0
 lt 0, zloc, 1
 lt 0, col, 0xFFFF
 lt 0, int, 1
@@ -167,7 +169,11 @@ def _scene(source: str):
     from ..emu.options import EmuOptions
     from ..emu.run import run_program
 
-    words = list(assemble_source(source, "<datapath>").program.words)
+    result = assemble_source(source, "<datapath>")
+    errors = [d.message for d in result.diagnostics if d.severity == "error"]
+    if errors:
+        raise AssertionError(f"the counting scene does not assemble: {errors}")
+    words = list(result.program.words)
     scenes = []
     run_program(words, EmuOptions(precision="fp64", width=1, height=1), on_scene=lambda s, n: scenes.append(s),
                 keep_frames=False)

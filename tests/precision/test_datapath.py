@@ -34,6 +34,13 @@ def test_distance_surface_and_lighting_counts():
     assert raster_counts().stages["lighting"] == s["lighting"]
 
 
+def test_camera_rotation_is_counted():
+    # a rotated camera: q normalised (4 mul, 3 add, 1 sqrt, 4 div), each direction rotated (24 mul, 17 add)
+    ray, raster = raytrace_counts().stages, raster_counts().stages
+    assert ray["camera"]["add"] == 3 + 17 and ray["camera"]["sqrt"] == 1 and ray["camera"]["div"] == 4
+    assert raster["to_camera"] == {"add": 3 + 17, "mul": 24}  # translate, then rotate each vertex
+
+
 def test_totals_sum_the_stages_and_cost_sums_the_units():
     for counts in (raytrace_counts(), raster_counts()):
         for op, n in counts.total.items():

@@ -176,8 +176,8 @@ class HostileDevice:
     def _talk(self, conn: socket.socket) -> None:
         buf = bytearray()
         while not self._stop.is_set():
-            if self.behaviour == "stall":
-                time.sleep(0.05)  # never reads: the sender's writes back up
+            if self.behaviour == "stall" and self.frames > self.close_after:
+                time.sleep(0.05)  # stops reading: the sender's writes back up
                 continue
             if not select.select([conn], [], [], 0.01 if self._held else 0.05)[0]:
                 if self._held:  # idle: what was held back arrives now
@@ -200,6 +200,8 @@ class HostileDevice:
                 self.frames += 1
                 if self.behaviour == "close" and self.frames > self.close_after:
                     return
+                if self.behaviour == "stall" and self.frames > self.close_after:
+                    break
                 out = self.answer(frame, self.behaviour)
                 if self.behaviour == "trickle":
                     delay = self.rng.choice([0.001, 0.005, 0.02])
@@ -215,7 +217,7 @@ class HostileDevice:
         honest = self.core.handle(frame)
         if behaviour == "mixed":
             behaviour = rng.choice(MIXABLE)
-        if honest is None or behaviour in ("honest", "trickle", "close"):
+        if honest is None or behaviour in ("honest", "trickle", "close", "stall"):
             return wire(honest) if honest else b""
         if behaviour == "silence":
             return b""

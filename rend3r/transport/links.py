@@ -42,6 +42,10 @@ class Link:
     def recv(self, timeout: float) -> bytes | None:
         raise NotImplementedError
 
+    def limit_writes(self, seconds: float) -> None:
+        """Make a write that cannot proceed for ``seconds`` fail instead of blocking (links
+        that can block: a serial port whose other end stopped reading)."""
+
     def close(self) -> None:
         """Release the link's resources."""
 
@@ -92,6 +96,9 @@ class SerialLink(Link):
             data = b"\0" + data
             self._sent = True
         self.write(data)
+
+    def limit_writes(self, seconds: float) -> None:
+        self.port.write_timeout = seconds  # pyserial raises SerialTimeoutException
 
     def write(self, data: bytes) -> None:
         """Write raw bytes (paced when ``line_rate`` is set)."""
@@ -356,6 +363,9 @@ class FaultLink(Link):
                         self._inbox.append(self._held_in)
                         self._held_in = None
         return self._inbox.popleft()
+
+    def limit_writes(self, seconds: float) -> None:
+        self.inner.limit_writes(seconds)
 
     def close(self) -> None:
         self.inner.close()

@@ -2,7 +2,8 @@
 
 A load is BEGIN, then the DATA frames with up to ``window`` of them unacknowledged, then
 COMMIT. A frame is resent when its ACK is late by ``timeout`` seconds or it is NACKed with
-a transient reason; after ``retries`` resends it fails with :class:`SendError`. If the
+a transient reason; after ``retries`` resends it fails with :class:`SendError` (a write
+that cannot proceed for as long fails too: a device that stopped reading). If the
 device has lost the load (it was reset, or another sender replaced it) the whole load
 restarts under a new load id, also at most ``retries`` times.
 """
@@ -85,6 +86,7 @@ class Sender:
         self.rng = rng or random.Random()
         self.stats = SendStats()
         self._seq = self.rng.randrange(1 << 16)
+        link.limit_writes((retries + 1) * timeout)  # a frame unwritable that long is unacknowledged too
 
     def load(self, words: list[int] | tuple[int, ...]) -> None:
         """Load ``words`` as the device's program; return once the device committed it."""

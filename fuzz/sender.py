@@ -9,11 +9,13 @@ replies one behaviour per case turns hostile: garbage bytes, invalid COBS, repli
 correct CRCs but wrong fields (type, seq, load, ref, length, version), NACK storms with
 any code, ACKs for frames never sent, duplicated and reordered ACKs, a huge run of bytes
 without a delimiter, silence, closing the connection mid-load, a device that stops
-reading, a slowly trickled valid reply, a lying STATUS, or a mix per frame. A case
+reading, a slowly trickled valid reply, a lying STATUS, TOO_LARGE to every request after
+BEGIN, or a mix per frame. A case
 passes when ``send`` exits 0 or 1 (1 with an ``error:`` line), never with a traceback or a
 signal, within the case's bound (``bound``: every frame's retries and every restart, plus
-``MARGIN``); behaviours that still complete a valid exchange must exit 0, those that
-cannot must exit 1. Prints ``fuzz/harness.py``'s table header and one row.
+``MARGIN``) and with a peak RSS of at most ``MAX_RSS``; behaviours that still complete a
+valid exchange must exit 0, those that cannot must exit 1. Prints ``fuzz/harness.py``'s
+table header and one row, then the failures and the count of wrong verdicts.
 """
 
 from __future__ import annotations
@@ -44,6 +46,9 @@ from rend3r.transport.protocol import (  # noqa: E402
 MARGIN = 30.0
 """Seconds a case may take beyond its protocol bound: interpreter start-up on a loaded machine."""
 
+MAX_RSS = 256 << 20
+"""Peak RSS a case may reach: ``send`` holds one program and a frame's worth of input."""
+
 #: Behaviour -> the exit statuses that are right for it (0: the exchange still completes).
 BEHAVIOURS: dict[str, tuple[int, ...]] = {
     "honest": (0,),
@@ -55,8 +60,8 @@ BEHAVIOURS: dict[str, tuple[int, ...]] = {
     "dup-reorder": (0,),
     "huge": (0, 1),
     "silence": (1,),
-    "close": (1,),
-    "stall": (1,),
+    "close": (0, 1),  # 0 when the exchange ends before the device closes
+    "stall": (0, 1),  # or stops reading
     "trickle": (0, 1),
     "status-lies": (1,),
     "too-large": (1,),
@@ -147,7 +152,7 @@ class HostileDevice:
         self.core = DeviceCore(max_words=1 << 16)
         self.server = socket.create_server(("127.0.0.1", 0))
         self.url = f"socket://127.0.0.1:{self.server.getsockname()[1]}"
-        self.close_after = self.rng.randrange(0, 6)
+        self.turns_after = self.rng.randrange(0, 6)  # frames answered before it closes or stops reading
         self.frames = 0
         self._held: list[bytes] = []
         self._stop = threading.Event()
@@ -176,7 +181,7 @@ class HostileDevice:
     def _talk(self, conn: socket.socket) -> None:
         buf = bytearray()
         while not self._stop.is_set():
-            if self.behaviour == "stall" and self.frames > self.close_after:
+            if self.behaviour == "stall" and self.frames > self.turns_after:
                 time.sleep(0.05)  # stops reading: the sender's writes back up
                 continue
             if not select.select([conn], [], [], 0.01 if self._held else 0.05)[0]:
@@ -198,9 +203,9 @@ class HostileDevice:
                 except cobs.CobsError:
                     continue
                 self.frames += 1
-                if self.behaviour == "close" and self.frames > self.close_after:
+                if self.behaviour == "close" and self.frames > self.turns_after:
                     return
-                if self.behaviour == "stall" and self.frames > self.close_after:
+                if self.behaviour == "stall" and self.frames > self.turns_after:
                     break
                 out = self.answer(frame, self.behaviour)
                 if self.behaviour == "trickle":
@@ -287,8 +292,9 @@ def run_sender(case: Case, folder: Path) -> CaseResult:
 
 
 def right_verdict(case: Case, result: CaseResult) -> bool:
-    """The exit status is one the behaviour allows (a hang or a crash is counted by the tally)."""
-    return result.returncode in BEHAVIOURS[case.behaviour] or not result.ok
+    """The exit status is one the behaviour allows and the peak RSS at most ``MAX_RSS`` (a
+    hang or a crash is counted by the tally)."""
+    return (result.returncode in BEHAVIOURS[case.behaviour] or not result.ok) and result.rss_bytes <= MAX_RSS
 
 
 def main() -> None:
@@ -310,8 +316,9 @@ def main() -> None:
     print(tally.report())
     tally.print_failures()
     for case, result in wrong[:5]:
-        print(f"WRONG VERDICT {result.returncode} for {case}: {result.stderr[-500:]}", file=sys.stderr)
-    print(f"{len(wrong)} wrong verdicts", file=sys.stderr)
+        print(f"WRONG VERDICT {result.returncode} ({result.rss_bytes >> 20} MiB) for {case}: {result.stderr[-500:]}",
+              file=sys.stderr)
+    print(f"{len(wrong)} wrong verdicts (exit status or RSS)", file=sys.stderr)
     sys.exit(1 if tally.failures or wrong else 0)
 
 

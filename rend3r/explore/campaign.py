@@ -77,6 +77,13 @@ def score_design(reference: Rendering, design: Rendering) -> Score:
     )
 
 
+def render_and_score(program: ProgramSpec, precision: str, reference: Rendering, subnormals: str, width: int,
+                     height: int, jobs: int = 0) -> Score:
+    """One campaign task: render ``program`` in ``precision`` and score it against ``reference``
+    (its fp64 rendering), so only the score travels back from a worker."""
+    return score_design(reference, render_design(program, precision, subnormals, width, height, jobs))
+
+
 def design_cost(precision: str) -> Resources:
     """Modelled cost of a device whose raytrace and raster datapaths both work in ``precision``
     (:mod:`rend3r.precision.datapath` counts, :mod:`rend3r.precision.cost` per unit)."""

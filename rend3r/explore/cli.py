@@ -10,6 +10,7 @@ from pathlib import Path
 
 import click
 
+from ..campaign.options import SCHEDULER
 from ..cliutil import JOBS, SIZE
 from ..progress import Progress, quiet_option
 
@@ -56,9 +57,10 @@ def load_spec(path: Path):
 @click.option("--min-psnr", type=click.FloatRange(0), default=40.0, show_default=True, metavar="DB",
               help="PSNR against fp64 a format must reach to serve a program.")
 @JOBS
+@SCHEDULER
 @quiet_option
 def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str], subnormals: str,
-                    size: tuple[int, int], min_psnr: float, jobs: int, quiet: bool) -> None:
+                    size: tuple[int, int], min_psnr: float, jobs: int, scheduler: str, quiet: bool) -> None:
     """Which uniform number format each PROGRAM needs, and what each format costs.
 
     Renders every program in every format of LIST and in fp64, scores each against
@@ -68,15 +70,18 @@ def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str
     (docs/precision.md). Writes DIR/results.csv (a row per program and format),
     DIR/pareto.svg (LUTs against worst PSNR, the Pareto front joined) and
     DIR/summary.md (per program the cheapest format reaching --min-psnr, or none),
-    all or nothing.
+    all or nothing. The renders run as independent tasks on --scheduler
+    (docs/campaigns.md); the results do not depend on where they ran.
 
     \b
     Example:
       rend3r explore programs/*.asm -o out/explore
       rend3r explore programs/shadow.asm -o out/e --formats e4m3,bf16,e6m9 --size 64x48
+      rend3r explore programs/*.asm -o out/explore --scheduler tcp://10.0.0.5:8786
     """
+    from ..campaign.runner import Campaign
     from ..fileio import Outputs
-    from .campaign import REFERENCE, design_cost, render_design, score_design
+    from .campaign import REFERENCE, design_cost, render_and_score, render_design
     from .report import Results, pareto_svg, results_csv, summary_md
 
     width, height = size
@@ -86,15 +91,15 @@ def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str
         if len({s.name for s in specs}) != len(specs):
             raise click.UsageError("two programs have the same name; results.csv keys rows by name")
         costs = {f: design_cost(f) for f in formats}
-        scores = {}
-        render = partial(render_design, subnormals=subnormals, width=width, height=height, jobs=jobs)
-        with Progress(len(specs) * (len(formats) + 1), "explore", quiet=quiet) as bar:
-            for spec in specs:
-                reference = render(spec, REFERENCE)
-                bar.advance(1)
-                for f in formats:
-                    scores[spec.name, f] = score_design(reference, render(spec, f))
-                    bar.advance(1)
+        options = dict(subnormals=subnormals, width=width, height=height, jobs=jobs)
+        pairs = [(spec, f) for spec in specs for f in formats]
+        with Campaign(scheduler) as campaign, Progress(len(specs) + len(pairs), "explore", quiet=quiet) as bar:
+            references = campaign.map(partial(render_design, precision=REFERENCE, **options), [(s,) for s in specs],
+                                      [f"{s.name} in {REFERENCE}" for s in specs], bar)
+            reference = {s.name: r for s, r in zip(specs, references)}
+            found = campaign.map(partial(render_and_score, **options), [(s, f, reference[s.name]) for s, f in pairs],
+                                 [f"{s.name} in {f}" for s, f in pairs], bar)
+        scores = {(s.name, f): score for (s, f), score in zip(pairs, found)}
         results = Results(specs, formats, scores, costs, min_psnr, subnormals, size)
         command = "rend3r " + shlex.join(sys.argv[1:]) if sys.argv[1:2] == ["explore"] else "rend3r explore ..."
         out.write(files["results.csv"], results_csv(results))

@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import click
 
+from ..campaign.options import SCHEDULER
 from ..cliutil import JOBS, PRECISION, SIZE
 from ..errors import Rend3rError
+from ..progress import Progress, ProgressFactory, hidden, quiet_option
 from .catalog import ExampleProgram, program_paths, read_header
 
 if TYPE_CHECKING:
@@ -34,41 +37,66 @@ def render_example(program: ExampleProgram, options: EmuOptions) -> list[Frame]:
     return list(result.frames)
 
 
-def render_all(
-    programs_dir: Path, out_dir: Path, options: EmuOptions, echo: Callable[[str], None] = print
-) -> list[str]:
+@dataclass(frozen=True)
+class Rendered:
+    """One program's outcome: its frames as PNG files (name -> bytes) or why it failed."""
+
+    pngs: dict[str, bytes]
+    seconds: float
+    error: str | None = None
+
+
+def render_to_pngs(path: Path, options: EmuOptions) -> Rendered:
+    """The campaign task of ``render-all``: read ``path``'s header, render its frames and
+    encode each as a PNG in memory; a Rend3rError is the outcome, not raised, so one broken
+    program does not stop the others."""
+    from ..emu.image import save_png
+
+    start = time.perf_counter()
+    pngs: dict[str, bytes] = {}
+    try:
+        program = read_header(path)
+        for i, frame in enumerate(render_example(program, options)):
+            save_png(frame.rgb565, Path(f"{program.frame_name(i)}.png"),
+                     sink=lambda p, data: pngs.__setitem__(p.name, bytes(data)))
+    except Rend3rError as exc:
+        return Rendered({}, time.perf_counter() - start, str(exc))
+    return Rendered(pngs, time.perf_counter() - start)
+
+
+def render_all(programs_dir: Path, out_dir: Path, options: EmuOptions, scheduler: str = "none",
+               echo: Callable[[str], None] = print, progress: ProgressFactory = hidden) -> list[str]:
     """Render every program in ``programs_dir`` to ``out_dir/<name>[.NNN].png``.
 
-    Prints one progress line per program; a program that fails is reported and skipped.
-    Returns the names of the programs that failed.
+    The programs render as tasks on ``scheduler`` (:class:`rend3r.campaign.runner.Campaign`);
+    then one line per program is printed, in name order, a program that failed is reported,
+    and the others' PNGs are written together (:class:`rend3r.fileio.Outputs`). Returns the
+    names of the programs that failed.
     """
-    from ..emu.image import save_png
-    from ..fileio import make_output_folder
+    from ..campaign.runner import Campaign
+    from ..fileio import Outputs, make_output_folder
 
     paths = program_paths(programs_dir)
     if not paths:
         raise Rend3rError(f"no *.asm programs in {programs_dir}")
-    make_output_folder(out_dir)
-    failed: list[str] = []
-    for n, path in enumerate(paths, 1):
-        prefix = f"[{n}/{len(paths)}] {path.stem}:"
-        start = time.perf_counter()
-        try:
-            program = read_header(path)
-            frames = render_example(program, options)
-            for i, frame in enumerate(frames):
-                save_png(frame.rgb565, out_dir / f"{program.frame_name(i)}.png")
-        except Rend3rError as exc:
-            echo(f"{prefix} FAILED: {exc}")
-            failed.append(path.stem)
-            continue
-        elapsed = time.perf_counter() - start
-        plural = "s" if len(frames) != 1 else ""
-        echo(
-            f"{prefix} {len(frames)} frame{plural} {options.width}x{options.height} "
-            f"{options.arith.label} in {elapsed:.2f} s -> {out_dir / program.frame_name(0)}.png"
-            + (" ..." if len(frames) > 1 else "")
-        )
+    make_output_folder(out_dir)  # an unwritable folder is refused before any work
+    with Campaign(scheduler) as campaign, progress(len(paths), "render-all") as bar:
+        outcomes = campaign.map(partial(render_to_pngs, options=options), [(p,) for p in paths],
+                                [p.stem for p in paths], bar)
+    with Outputs() as out:
+        failed: list[str] = []
+        for n, (path, outcome) in enumerate(zip(paths, outcomes), 1):
+            prefix = f"[{n}/{len(paths)}] {path.stem}:"
+            if outcome.error is not None:
+                echo(f"{prefix} FAILED: {outcome.error}")
+                failed.append(path.stem)
+                continue
+            for name, data in outcome.pngs.items():
+                out.write(out_dir / name, data)
+            first, frames = next(iter(outcome.pngs)), len(outcome.pngs)
+            echo(f"{prefix} {frames} frame{'s' if frames != 1 else ''} {options.width}x{options.height} "
+                 f"{options.arith.label} in {outcome.seconds:.2f} s -> {out_dir / first}" + (" ..." if frames > 1 else ""))
+        out.commit()
     return failed
 
 
@@ -80,18 +108,23 @@ def render_all(
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormal handling.")
 @click.option("--size", type=SIZE, default="512x384", show_default=True, help="Image size (1..8192 each).")
 @JOBS
+@SCHEDULER
+@quiet_option
 def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnormals: str, size: tuple[int, int],
-                       jobs: int) -> None:
+                       jobs: int, scheduler: str, quiet: bool) -> None:
     """Render every PROGRAMS_DIR/*.asm (default: programs) to PNGs in folder DIR.
 
     Each program's header sets its frame count (``; frames: N``) and mode. Files are
     named after the program, with the frame number for animations
     (``animation.000.png``). A program that fails (a bad header, an error while
-    rendering or writing) is reported and the others still render; exit status 1 then.
+    rendering) is reported and the others still render; exit status 1 then. The
+    programs render as independent tasks on --scheduler (docs/campaigns.md); the PNGs
+    are written together once every program has rendered.
 
     \b
     Example:
       rend3r render-all programs -o out/renders --precision fp32
+      rend3r render-all programs -o out/renders --scheduler tcp://10.0.0.5:8786
     """
     from ..emu import EmuOptions
 
@@ -99,6 +132,7 @@ def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnor
         raise Rend3rError(f"{programs_dir} is not a folder")
     width, height = size
     options = EmuOptions(precision=precision, subnormals=subnormals, width=width, height=height, jobs=jobs)
-    failed = render_all(programs_dir, out_dir, options, echo=click.echo)
+    failed = render_all(programs_dir, out_dir, options, scheduler, echo=click.echo,
+                        progress=partial(Progress, quiet=quiet))
     if failed:
         raise Rend3rError(f"{len(failed)} program(s) failed: {', '.join(failed)}")

@@ -108,7 +108,7 @@ def test_a_program_without_frames_is_an_error_and_writes_nothing(tmp_path):
     r = CliRunner().invoke(main, ["explore", str(empty), "-o", str(tmp_path / "o"), "--size", "8x6",
                                   "--formats", "e4m3"])
     assert r.exit_code == 1
-    assert "rend3r: error: empty: rendered no frame" in r.output
+    assert "rend3r: error: empty in fp64: empty: rendered no frame" in r.output
     assert not (tmp_path / "o").exists()
 
 

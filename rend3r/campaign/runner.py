@@ -32,6 +32,9 @@ R = TypeVar("R")
 #: ``--scheduler`` values besides ``tcp://HOST:PORT``.
 LOCAL, SERIAL = "local", "none"
 
+#: How long to wait for an existing scheduler to answer.
+CONNECT_TIMEOUT = "10s"
+
 #: What to install for the cluster paths.
 EXTRA = "pip install 'rend3r[campaign]'"
 
@@ -107,7 +110,7 @@ class Campaign:
                                              dashboard_address=None, silence_logs=logging.CRITICAL)
                 self._client = Client(self._cluster)
             else:
-                self._client = Client(self.scheduler, timeout="10s")
+                self._client = Client(self.scheduler, timeout=CONNECT_TIMEOUT)
         except OSError as exc:
             self._close()
             raise Rend3rError(f"cannot reach the Dask scheduler at {self.scheduler}: {exc}") from None

@@ -1,0 +1,144 @@
+"""The campaign runner: input order, named failures, Ctrl-C, the serial fallback."""
+
+from __future__ import annotations
+
+import operator
+import threading
+import time
+
+import pytest
+from click.testing import CliRunner
+
+from rend3r.campaign import runner
+from rend3r.campaign.runner import Campaign, TaskFailed, parse_scheduler
+from rend3r.cli import main
+from rend3r.errors import Rend3rError
+
+needs_dask = pytest.mark.skipif(not runner.dask_installed(),
+                                reason="Dask distributed is not installed (pip install 'rend3r[campaign]')")
+
+
+class Counter:
+    """A progress bar that counts the units it is told about, and may act on the n-th."""
+
+    def __init__(self, on=None) -> None:
+        self.done = 0
+        self.on = on
+
+    def advance(self, units: int) -> None:
+        self.done += units
+        if self.on is not None:
+            self.on(self.done)
+
+
+def slow_square(x: int) -> int:
+    time.sleep(0.01 * (x % 3))  # finish out of order
+    return x * x
+
+
+def fail_on_three(x: int) -> int:
+    if x == 3:
+        raise Rend3rError("three is not allowed")
+    if x == 4:
+        return 1 // 0
+    return x
+
+
+@pytest.mark.parametrize("text, value", [("none", "none"), ("LOCAL", "local"),
+                                         ("tcp://127.0.0.1:8786", "tcp://127.0.0.1:8786"),
+                                         ("tcp://[::1]:8786", "tcp://[::1]:8786")])
+def test_scheduler_addresses(text, value):
+    assert parse_scheduler(text) == value
+
+
+@pytest.mark.parametrize("text", ["tcp://host", "tcp://:8786", "tcp://host:0", "tcp://host:70000", "host:8786",
+                                  "threads"])
+def test_bad_scheduler_addresses(text):
+    with pytest.raises(ValueError, match="expected local, none or tcp://HOST:PORT"):
+        parse_scheduler(text)
+
+
+def test_a_bad_scheduler_option_exits_2(tmp_path):
+    r = CliRunner().invoke(main, ["render-all", str(tmp_path), "-o", str(tmp_path / "o"), "--scheduler", "bogus"])
+    assert r.exit_code == 2 and "--scheduler" in r.output and "tcp://HOST:PORT" in r.output
+
+
+@pytest.mark.parametrize("scheduler", ["none", pytest.param("local", marks=needs_dask)])
+def test_results_come_back_in_input_order(scheduler):
+    inputs = [(x,) for x in range(12)]
+    bar = Counter()
+    with Campaign(scheduler) as campaign:
+        assert campaign.distributed == (scheduler == "local")
+        assert campaign.map(slow_square, inputs, [str(x) for x in range(12)], bar) == [x * x for x in range(12)]
+        assert campaign.map(operator.add, [(1, 2), (3, 4)], ["a", "b"], bar) == [3, 7]
+    assert bar.done == 14
+
+
+@pytest.mark.parametrize("scheduler", ["none", pytest.param("local", marks=needs_dask)])
+@pytest.mark.parametrize("inputs, message", [([1, 2, 3], "task 3: three is not allowed"),
+                                             ([1, 4], "task 4: ZeroDivisionError: integer division or modulo by zero")])
+def test_a_failing_task_is_named_with_its_error(scheduler, inputs, message):
+    with Campaign(scheduler) as campaign, pytest.raises(TaskFailed) as info:
+        campaign.map(fail_on_three, [(x,) for x in inputs], [f"task {x}" for x in inputs], Counter())
+    assert str(info.value) == message
+
+
+def test_without_dask_local_runs_serially_with_a_note(monkeypatch):
+    monkeypatch.setattr(runner, "dask_installed", lambda: False)
+    notes = []
+    with Campaign("local", note=notes.append) as campaign:
+        assert not campaign.distributed
+        assert campaign.map(slow_square, [(2,), (3,)], ["a", "b"], Counter()) == [4, 9]
+    assert notes == ["rend3r: note: Dask is not installed, running serially "
+                     "(pip install 'rend3r[campaign]' to use every core)"]
+    with pytest.raises(Rend3rError, match="--scheduler tcp://127.0.0.1:8786 needs Dask distributed"):
+        Campaign("tcp://127.0.0.1:8786").__enter__()
+
+
+started: list[int] = []
+
+
+def sleep_and_record(x: int) -> int:
+    started.append(x)
+    time.sleep(0.2)
+    return x
+
+
+@needs_dask
+def test_ctrl_c_cancels_the_tasks_in_flight():
+    def interrupt(done: int) -> None:
+        raise KeyboardInterrupt
+
+    started.clear()
+    with Campaign("local") as campaign:
+        with pytest.raises(KeyboardInterrupt):
+            campaign.map(sleep_and_record, [(x,) for x in range(40)], [str(x) for x in range(40)], Counter(interrupt))
+        time.sleep(1.0)  # the tasks left would run now, were they not cancelled
+        assert len(started) < 10
+        assert not any(campaign._client.processing().values())
+
+
+@needs_dask
+def test_an_unreachable_scheduler_is_a_clean_error(tmp_path, monkeypatch):
+    import socket
+
+    monkeypatch.setattr(runner, "CONNECT_TIMEOUT", "1s")
+
+    with socket.socket() as s:  # a port nothing listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    (tmp_path / "sphere.asm").write_text("nr\nnf\ner\ner\n")
+    r = CliRunner().invoke(main, ["render-all", str(tmp_path), "-o", str(tmp_path / "o"), "--size", "8x6",
+                                  "--scheduler", f"tcp://127.0.0.1:{port}"])
+    assert r.exit_code == 1
+    assert r.output.startswith(f"rend3r: error: cannot reach the Dask scheduler at tcp://127.0.0.1:{port}: ")
+
+
+@needs_dask
+def test_the_local_cluster_is_closed_with_the_run():
+    with Campaign("local") as campaign:
+        client = campaign._client
+        scheduler = client.cluster.scheduler
+        assert campaign.map(slow_square, [(1,)], ["one"], Counter()) == [1]
+    assert client.status == "closed" and scheduler.status.name == "closed"
+    assert not campaign.distributed

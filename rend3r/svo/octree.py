@@ -106,22 +106,44 @@ class Octree:
         return far
 
 
-def _level_nodes(codes: np.ndarray, depth: int, on_level: Callable[[int], None] = lambda n: None
-                 ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """Per level L = 0..depth-1: (node keys, valid masks, index of first child node);
-    ``on_level(1)`` after each level."""
-    levels = []
-    child_codes = codes
-    for _ in range(depth):
-        parents = child_codes >> 3  # sorted, because child_codes are
-        first = np.flatnonzero(np.r_[True, parents[1:] != parents[:-1]])
-        keys = parents[first]
-        bits = np.left_shift(np.uint8(1), (child_codes & 7).astype(np.uint8))  # 1 byte a child
-        valid = np.bitwise_or.reduceat(bits, first) if len(first) else np.zeros(0, np.uint8)
-        levels.append((keys, valid.astype(np.int64), first))
-        child_codes = keys
-        on_level(1)
-    return levels[::-1]
+_BLOCK = 1 << 22  # child codes per pass when deriving a level's nodes
+
+
+def _blocks(children: np.ndarray) -> list[tuple[int, int]]:
+    """Ranges of about ``_BLOCK`` sorted codes, each ending on a parent boundary."""
+    bounds = [0]
+    while bounds[-1] < len(children):
+        stop = bounds[-1] + _BLOCK
+        bounds.append(len(children) if stop >= len(children)
+                      else int(np.searchsorted(children, (children[stop] >> 3) << 3)))
+    return list(zip(bounds, bounds[1:]))
+
+
+def _heads(children: np.ndarray) -> np.ndarray:
+    """Index of the first of each run of codes with the same parent."""
+    parents = children >> 3
+    return np.flatnonzero(np.r_[True, parents[1:] != parents[:-1]])
+
+
+def _parents(children: np.ndarray, with_first: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """(keys, valid masks (uint8), index of the first child or None) of the parents of
+    sorted unique codes, block by block: no temporary as long as ``children``."""
+    blocks = _blocks(children)
+    total = sum(len(_heads(children[a:b])) for a, b in blocks)
+    keys = np.empty(total, dtype=np.int64)
+    valid = np.empty(total, dtype=np.uint8)
+    first = np.empty(total, dtype=np.int64) if with_first else None
+    at = 0
+    for a, b in blocks:
+        c = children[a:b]
+        head = _heads(c)
+        keys[at:at + len(head)] = c[head] >> 3
+        valid[at:at + len(head)] = np.bitwise_or.reduceat(np.left_shift(np.uint8(1), (c & 7).astype(np.uint8)),
+                                                          head)
+        if first is not None:
+            first[at:at + len(head)] = head + a
+        at += len(head)
+    return keys, valid, first
 
 
 def build_octree(coords: np.ndarray, depth: int, ptr_bits: int = DEFAULT_PTR_BITS) -> Octree:
@@ -154,94 +176,80 @@ def build_octree_codes(codes: np.ndarray, depth: int, ptr_bits: int = DEFAULT_PT
 
 
 def _build(codes: np.ndarray, depth: int, ptr_bits: int, advance: Callable[[int], None]) -> Octree:
+    """Levels bottom up (masks and first-child indexes only), far flags bottom up, words top down.
+
+    A level's pointers depend only on its own far slots and the level below's, so each
+    level's far set is iterated to its (least) fixed point on that level's arrays alone:
+    adding a far slot only moves later words further away, so the set only grows. The
+    deepest level, the largest, holds no pointers: only its masks are kept.
+    """
     if not 1 <= depth <= MAX_DEPTH:
         raise Rend3rError(f"octree depth must be 1..{MAX_DEPTH}, got {depth}")
     if not 4 <= ptr_bits <= 15:
         raise Rend3rError(f"pointer width must be 4..15 bits, got {ptr_bits}")
     if len(codes) == 0:
         raise Rend3rError("no voxels to build an octree from")
-    levels = _level_nodes(codes, depth, advance)
-    n_levels = len(levels)
-    counts = [len(k) for k, _, _ in levels]
-    # Per level L >= 1: parent index of each node and its rank inside the parent's table.
-    parent = []
-    rank = []
-    for lvl in range(1, n_levels):
-        keys = levels[lvl][0]
-        starts = levels[lvl - 1][2]  # first child of each parent (children sorted by parent)
-        flags = np.zeros(len(keys), dtype=np.int64)
-        flags[starts] = 1
-        par = np.cumsum(flags) - 1
-        parent.append(par)
-        rank.append(np.arange(len(keys)) - starts[par])
-    table_len = [np.bincount(parent[lvl - 1], minlength=counts[lvl - 1]) for lvl in range(1, n_levels)]
+    valid: list[np.ndarray] = [np.empty(0, np.uint8)] * depth
+    first: list[np.ndarray | None] = [None] * depth  # per level: index of each node's first child
+    keys = codes
+    for lvl in range(depth - 1, -1, -1):
+        keys, valid[lvl], first[lvl] = _parents(keys, lvl < depth - 1)
+        advance(1)
+    del keys
+    counts = [len(v) for v in valid]
     max_ptr = (1 << ptr_bits) - 1
     far = [np.zeros(c, dtype=bool) for c in counts]
-    while True:
-        addr, region, table_start, slots_before = _layout(counts, parent, rank, table_len, far,
-                                                          [lv[2] for lv in levels])
-        changed = False
-        for lvl in range(n_levels - 1):
-            table_addr = region[lvl + 1] + table_start[lvl + 1]
-            need = (table_addr - addr[lvl]) > max_ptr
-            if np.any(need & ~far[lvl]):
-                far[lvl] |= need
-                changed = True
-        if not changed:
+    below = np.zeros(counts[-1] + 1, dtype=np.int64)  # far slots before each node of the level below
+    for lvl in range(depth - 2, -1, -1):
+        table = first[lvl] + below[first[lvl]]  # each table's offset in the region below
+        group = _siblings(valid, first, lvl)[0]
+        index = np.arange(counts[lvl])
+        while True:
+            before = _far_before(far[lvl])
+            need = counts[lvl] + before[-1] + table - index - before[group] > max_ptr
+            if not np.any(need & ~far[lvl]):
+                break
+            far[lvl] |= need
+        below = before
+    words = np.zeros(counts[-1] + sum(int(f.sum()) for f in far[:-1]) + sum(counts[:-1]), dtype=np.uint32)
+    region = 0
+    for lvl in range(depth):
+        if lvl == depth - 1:  # leaves only: leaf mask = valid mask, no pointer
+            words[region:region + counts[lvl]] = valid[lvl].astype(np.uint32) * 257
+            advance(1)
             break
-    total = int(region[n_levels - 1] + _region_size(counts, far, n_levels - 1))
-    words = np.zeros(total, dtype=np.int64)
-    for lvl in range(n_levels):
-        valid = levels[lvl][1]
-        leaf = valid if lvl == n_levels - 1 else np.zeros_like(valid)
-        word = (valid << 8) | leaf
-        if lvl < n_levels - 1:
-            table_addr = region[lvl + 1] + table_start[lvl + 1]
-            rel = table_addr - addr[lvl]
-            is_far = far[lvl]
-            ptr = rel
-            if lvl > 0:  # the root's table is word 1: never far
-                # far slots follow the node's own table, in rank order of the far nodes
-                par = parent[lvl - 1]
-                slot_addr = region[lvl] + table_start[lvl][par] + table_len[lvl - 1][par] + slots_before[lvl]
-                ptr = np.where(is_far, slot_addr - addr[lvl], rel)
-            word |= (ptr << PTR_SHIFT) | np.where(is_far, FAR_BIT, 0)
-            if np.any(is_far):
-                words[slot_addr[is_far]] = rel[is_far]
-        words[addr[lvl]] = word
+        before = _far_before(far[lvl])
+        below = _far_before(far[lvl + 1])
+        group, end = _siblings(valid, first, lvl)
+        addr = region + np.arange(counts[lvl]) + before[group]
+        rel = region + counts[lvl] + before[-1] + first[lvl] + below[first[lvl]] - addr
+        is_far = far[lvl]
+        slot = region + end + before[:-1]  # far slots follow the node's own table, in rank order
+        ptr = np.where(is_far, slot - addr, rel)
+        if np.any(is_far) and int(rel[is_far].max()) >= 1 << 32:
+            raise Rend3rError("octree too large: a far pointer exceeds 32 bits")
+        words[addr] = (valid[lvl].astype(np.int64) << 8) | (ptr << PTR_SHIFT) | np.where(is_far, FAR_BIT, 0)
+        words[slot[is_far]] = rel[is_far]
+        region += counts[lvl] + int(before[-1])
         advance(1)
-    if words.max() >= 1 << 32:
-        raise Rend3rError("octree too large: a far pointer exceeds 32 bits")
-    return Octree(words.astype(np.uint32), depth, ptr_bits)
+    return Octree(words, depth, ptr_bits)
 
 
-def _region_size(counts: list[int], far: list[np.ndarray], lvl: int) -> int:
-    """Words in level ``lvl``'s region: its nodes plus the far slots they need."""
-    return counts[lvl] + int(far[lvl].sum())
+def _far_before(far: np.ndarray) -> np.ndarray:
+    """Far flags -> number of far nodes before each index (one more entry: the total)."""
+    out = np.zeros(len(far) + 1, dtype=np.int64)
+    np.cumsum(far, out=out[1:])
+    return out
 
 
-def _layout(counts: list[int], parent: list[np.ndarray], rank: list[np.ndarray],
-            table_len: list[np.ndarray], far: list[np.ndarray], first_child: list[np.ndarray]):
-    """Node addresses, region starts, table starts and far-slot ranks per level."""
-    n_levels = len(counts)
-    region = np.zeros(n_levels, dtype=np.int64)
-    addr = [np.zeros(1, dtype=np.int64)]
-    table_start = [np.zeros(1, dtype=np.int64)]
-    slots_before = [np.zeros(1, dtype=np.int64)]
-    for lvl in range(1, n_levels):
-        region[lvl] = region[lvl - 1] + _region_size(counts, far, lvl - 1)
-        par = parent[lvl - 1]
-        n_par = counts[lvl - 1]
-        far_per_table = np.bincount(par, weights=far[lvl].astype(np.int64), minlength=n_par).astype(np.int64)
-        size = table_len[lvl - 1] + far_per_table
-        start = np.concatenate(([0], np.cumsum(size)[:-1]))
-        table_start.append(start)
-        addr.append(region[lvl] + start[par] + rank[lvl - 1])
-        # number of far nodes before this one in the same table
-        cum_far = np.cumsum(far[lvl]) - far[lvl]
-        first_in_table = cum_far[first_child[lvl - 1][par]]
-        slots_before.append(cum_far - first_in_table)
-    return addr, region, table_start, slots_before
+def _siblings(valid: list[np.ndarray], first: list[np.ndarray | None], lvl: int
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """Per node of level ``lvl``: index of its first sibling and one past its last."""
+    if lvl == 0:
+        return np.zeros(1, dtype=np.int64), np.ones(1, dtype=np.int64)
+    size = popcount8(valid[lvl - 1])
+    start = first[lvl - 1]
+    return np.repeat(start, size), np.repeat(start + size, size)
 
 
 def split_word(word: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -172,25 +172,48 @@ def voxelize_surface(tri_grid: np.ndarray, n: int, max_voxels: int | None = None
 def _surface_keys(tri_grid: np.ndarray, n: int, key, max_voxels: int | None,
                   progress: ProgressFactory = hidden) -> np.ndarray:
     """Sorted unique ``key(coords)`` of the voxels the triangles overlap, batch by batch
-    (``progress``'s bar counts candidate voxels)."""
+    (``progress``'s bar counts candidate voxels).
+
+    Each batch's unique keys are appended to one growing buffer (8 bytes a key: growing
+    it in place maps more pages instead of copying), which is sorted and deduplicated in
+    place at the end: no second array of all the keys.
+    """
     tri_grid = tri_grid[np.any(np.cross(tri_grid[:, 1] - tri_grid[:, 0], tri_grid[:, 2] - tri_grid[:, 0]), axis=1)]
     tri_grid = _split_large(tri_grid, n)
     weight = _weight(tri_grid, n)
-    # batches keep only their unique keys (8 bytes a voxel) until the final merge
-    keys: list[np.ndarray] = []
+    keys = np.empty(0, dtype=np.int64)
     held = 0
     with progress(int(weight.sum()), "voxelising") as bar:
         for s in _batches(weight, _CHUNK):
-            keys.append(sorted_unique(key(_surface_chunk(tri_grid[s], n))))
+            batch = sorted_unique(key(_surface_chunk(tri_grid[s], n)))
             bar.advance(int(weight[s].sum()))
-            held += len(keys[-1])
+            if held + len(batch) > len(keys):
+                keys.resize(max(held + len(batch), len(keys) * 3 // 2), refcheck=False)
+            keys[held:held + len(batch)] = batch
+            held += len(batch)
+            del batch
             if max_voxels is not None and held > max_voxels:
-                keys = [sorted_unique(np.concatenate(keys))]
-                held = len(keys[0])
+                held = _dedupe(keys, held)
                 if held > max_voxels:
                     raise Rend3rError(f"the surface holds more than {max_voxels:,} voxels, the most the memory "
                                       "budget allows (--max-memory; use a smaller --depth)")
-    return sorted_unique(np.concatenate(keys)) if keys else np.empty(0, np.int64)
+    keys.resize(_dedupe(keys, held), refcheck=False)
+    return keys
+
+
+def _dedupe(values: np.ndarray, count: int) -> int:
+    """Sort ``values[:count]`` in place and move its distinct values to the front; their number."""
+    values[:count].sort()
+    kept = 0
+    last = None
+    for start in range(0, count, _CHUNK):
+        block = values[start:min(start + _CHUNK, count)]
+        keep = np.r_[block[0] != last if last is not None else True, block[1:] != block[:-1]]
+        last = block[-1]
+        unique = block[keep]
+        values[kept:kept + len(unique)] = unique
+        kept += len(unique)
+    return kept
 
 
 def fill_solid(tri_grid: np.ndarray, n: int, max_voxels: int | None = None) -> np.ndarray:

@@ -1,0 +1,110 @@
+"""Campaigns on an existing cluster: a real ``dask scheduler`` and two ``dask worker``
+processes on 127.0.0.1, one of them killed in the middle of a campaign."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+from functools import partial
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from rend3r.campaign.runner import Campaign, dask_installed
+from rend3r.cli import main
+
+pytestmark = [
+    pytest.mark.skipif(not dask_installed(), reason="Dask distributed is not installed (pip install 'rend3r[campaign]')"),
+    pytest.mark.skipif(shutil.which("dask") is None, reason="the dask command (dask scheduler, dask worker) is not on PATH"),
+]
+
+PROGRAMS = Path(__file__).parents[2] / "programs"
+NAMES = ("sphere.asm", "shadow.asm", "tri_cube.asm", "lights.asm")
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def cluster():
+    """``(address, workers)``: a scheduler and two one-thread workers without nannies (a
+    killed worker stays dead), all stopped at the end."""
+    from distributed import Client
+
+    address = f"tcp://127.0.0.1:{free_port()}"
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[2])}
+    quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+    processes = [subprocess.Popen(["dask", "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
+                                   "--no-dashboard"], **quiet)]
+    try:
+        with Client(address, timeout="30s") as client:
+            for name in ("a", "b"):
+                processes.append(subprocess.Popen(["dask", "worker", address, "--name", name, "--nthreads", "1",
+                                                   "--no-nanny", "--no-dashboard", "--host", "127.0.0.1"], **quiet))
+            client.wait_for_workers(2, timeout=60)
+        yield address, processes[1:]
+    finally:
+        for p in reversed(processes):
+            p.terminate()
+        for p in reversed(processes):
+            try:
+                p.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+
+
+def explore(out: Path, scheduler: str):
+    return CliRunner().invoke(main, ["explore", *(str(PROGRAMS / n) for n in NAMES), "-o", str(out),
+                                     "--size", "24x18", "--formats", "e4m3,bf16,fp32", "--scheduler", scheduler])
+
+
+def test_explore_on_an_existing_cluster_matches_serial(tmp_path, cluster):
+    address, _ = cluster
+    for out, scheduler in ((tmp_path / "serial", "none"), (tmp_path / "tcp", address)):
+        r = explore(out, scheduler)
+        assert r.exit_code == 0, r.output
+    for name in ("results.csv", "pareto.svg", "summary.md"):
+        assert (tmp_path / "tcp" / name).read_bytes() == (tmp_path / "serial" / name).read_bytes()
+
+
+class KillOnce:
+    """A progress bar that kills ``worker`` when the ``at``-th task has come back."""
+
+    def __init__(self, worker: subprocess.Popen, at: int) -> None:
+        self.worker, self.at, self.done = worker, at, 0
+
+    def advance(self, units: int) -> None:
+        self.done += units
+        if self.done == self.at:
+            self.worker.send_signal(signal.SIGKILL)
+            self.worker.wait(timeout=10)
+
+
+def test_a_worker_killed_mid_campaign_has_its_tasks_rerun(cluster):
+    from rend3r.explore.campaign import REFERENCE, render_and_score, render_design
+    from rend3r.explore.cli import load_spec
+
+    address, workers = cluster
+    specs = [load_spec(PROGRAMS / n) for n in NAMES]
+    options = dict(subnormals="ftz", width=48, height=36, jobs=1)
+    references = [render_design(s, REFERENCE, **options) for s in specs]
+    inputs = [(s, f, r) for s, r in zip(specs, references) for f in ("e4m3", "e5m6", "bf16", "e6m9", "fp24", "fp32")]
+    names = [f"{s.name} in {f}" for s, f, _ in inputs]
+    task = partial(render_and_score, **options)
+    serial = [task(*args) for args in inputs]
+
+    bar = KillOnce(workers[0], at=3)
+    with Campaign(address) as campaign:
+        found = campaign.map(task, inputs, names, bar)
+    assert workers[0].returncode == -signal.SIGKILL and workers[1].poll() is None
+    assert bar.done == len(inputs)
+    assert found == serial

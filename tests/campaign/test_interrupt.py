@@ -1,0 +1,32 @@
+"""Ctrl-C during a campaign on the local cluster: exit 130, nothing written, nothing left running."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from rend3r.campaign.runner import dask_installed
+
+PROGRAMS = Path(__file__).parents[2] / "programs"
+
+
+@pytest.mark.skipif(not dask_installed(), reason="Dask distributed is not installed (pip install 'rend3r[campaign]')")
+def test_ctrl_c_exits_130_and_writes_nothing(tmp_path):
+    out = tmp_path / "out" / "explore"
+    command = [sys.executable, "-m", "rend3r", "explore", *map(str, sorted(PROGRAMS.glob("*.asm"))),
+               "-o", str(out), "--size", "128x96", "--scheduler", "local"]
+    run = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(5)  # the cluster is up and rendering: the whole campaign takes far longer
+    assert run.poll() is None, run.communicate()
+    sent = time.monotonic()
+    run.send_signal(signal.SIGINT)
+    _, err = run.communicate(timeout=60)
+    assert run.returncode == 130, err
+    assert err.endswith("rend3r: interrupted\n")
+    assert time.monotonic() - sent < 10  # the tasks not yet started were cancelled, not run (the rest takes > 15 s)
+    assert not (tmp_path / "out").exists()

@@ -21,20 +21,39 @@ if TYPE_CHECKING:
     from ..emu import EmuOptions, Frame
 
 
-def render_example(program: ExampleProgram, options: EmuOptions) -> list[Frame]:
-    """Assemble/load ``program`` and render its frames (RGB565, depth, provenance).
+@dataclass(frozen=True)
+class LoadedExample:
+    """A program read and assembled, with the options it renders with: all a render needs."""
 
-    The mode comes from the program's header, else from the emulator's hint (``tr`` in the
-    source means raster), else ``options.mode``.
-    """
-    from ..emu import load_program, run_program
+    program: ExampleProgram
+    words: tuple[int, ...]
+    options: EmuOptions
+
+
+def load_example(program: ExampleProgram, options: EmuOptions) -> LoadedExample:
+    """Assemble/load ``program``. The mode comes from the program's header, else from the
+    emulator's hint (``tr`` in the source means raster), else ``options.mode``."""
+    from ..emu import load_program
 
     loaded = load_program(program.path)
     mode = program.mode or loaded.mode_hint or options.mode
-    result = run_program(loaded.words, options=replace(options, mode=mode), frames=program.frames)
+    return LoadedExample(program, tuple(loaded.words), replace(options, mode=mode))
+
+
+def render_loaded(example: LoadedExample) -> list[Frame]:
+    """Render a loaded program's frames (RGB565, depth, provenance); as many as its header says."""
+    from ..emu import run_program
+
+    program = example.program
+    result = run_program(list(example.words), options=example.options, frames=program.frames)
     if len(result.frames) != program.frames:
         raise Rend3rError(f"{program.path}: rendered {len(result.frames)} frame(s), header says frames: {program.frames}")
     return list(result.frames)
+
+
+def render_example(program: ExampleProgram, options: EmuOptions) -> list[Frame]:
+    """Assemble/load ``program`` and render its frames (:func:`load_example`, :func:`render_loaded`)."""
+    return render_loaded(load_example(program, options))
 
 
 @dataclass(frozen=True)
@@ -46,18 +65,25 @@ class Rendered:
     error: str | None = None
 
 
-def render_to_pngs(path: Path, options: EmuOptions) -> Rendered:
-    """The campaign task of ``render-all``: read ``path``'s header, render its frames and
-    encode each as a PNG in memory; a Rend3rError is the outcome, not raised, so one broken
-    program does not stop the others."""
+def read_example(path: Path, options: EmuOptions) -> LoadedExample | Rendered:
+    """``path``'s header and words, or the failed outcome when either is wrong."""
+    try:
+        return load_example(read_header(path), options)
+    except Rend3rError as exc:
+        return Rendered({}, 0.0, str(exc))
+
+
+def render_to_pngs(example: LoadedExample) -> Rendered:
+    """The campaign task of ``render-all``: render a loaded program and encode each frame as
+    a PNG in memory; a Rend3rError is the outcome, not raised, so one program that cannot
+    be rendered does not stop the others."""
     from ..emu.image import save_png
 
     start = time.perf_counter()
     pngs: dict[str, bytes] = {}
     try:
-        program = read_header(path)
-        for i, frame in enumerate(render_example(program, options)):
-            save_png(frame.rgb565, Path(f"{program.frame_name(i)}.png"),
+        for i, frame in enumerate(render_loaded(example)):
+            save_png(frame.rgb565, Path(f"{example.program.frame_name(i)}.png"),
                      sink=lambda p, data: pngs.__setitem__(p.name, bytes(data)))
     except Rend3rError as exc:
         return Rendered({}, time.perf_counter() - start, str(exc))
@@ -68,8 +94,8 @@ def render_all(programs_dir: Path, out_dir: Path, options: EmuOptions, scheduler
                echo: Callable[[str], None] = print, progress: ProgressFactory = hidden) -> list[str]:
     """Render every program in ``programs_dir`` to ``out_dir/<name>[.NNN].png``.
 
-    The programs render as tasks on ``scheduler`` (:class:`rend3r.campaign.runner.Campaign`);
-    then one line per program is printed, in name order, a program that failed is reported,
+    The programs are read and assembled here and render as tasks on ``scheduler``
+    (:class:`rend3r.campaign.runner.Campaign`), so workers need no files; then one line per program is printed, in name order, a program that failed is reported,
     and the others' PNGs are written together (:class:`rend3r.fileio.Outputs`). Returns the
     names of the programs that failed.
     """
@@ -80,9 +106,11 @@ def render_all(programs_dir: Path, out_dir: Path, options: EmuOptions, scheduler
     if not paths:
         raise Rend3rError(f"no *.asm programs in {programs_dir}")
     make_output_folder(out_dir)  # an unwritable folder is refused before any work
-    with Campaign(scheduler) as campaign, progress(len(paths), "render-all") as bar:
-        outcomes = campaign.map(partial(render_to_pngs, options=options), [(p,) for p in paths],
-                                [p.stem for p in paths], bar)
+    examples = [read_example(p, options) for p in paths]
+    loaded = [e for e in examples if isinstance(e, LoadedExample)]
+    with Campaign(scheduler) as campaign, progress(len(loaded), "render-all") as bar:
+        rendered = iter(campaign.map(render_to_pngs, [(e,) for e in loaded], [e.program.name for e in loaded], bar))
+    outcomes = [next(rendered) if isinstance(e, LoadedExample) else e for e in examples]
     with Outputs() as out:
         failed: list[str] = []
         for n, (path, outcome) in enumerate(zip(paths, outcomes), 1):

@@ -108,3 +108,19 @@ def test_a_worker_killed_mid_campaign_has_its_tasks_rerun(cluster):
     assert workers[0].returncode == -signal.SIGKILL and workers[1].poll() is None
     assert bar.done == len(inputs)
     assert found == serial
+
+
+def test_render_all_on_an_existing_cluster_matches_serial(tmp_path, cluster):
+    address, _ = cluster
+    src = tmp_path / "programs"
+    src.mkdir()
+    for name in ("sphere.asm", "animation.asm", "tri_overlap.asm"):
+        shutil.copy(PROGRAMS / name, src / name)
+    pngs = {}
+    for scheduler in ("none", address):
+        out = tmp_path / scheduler.replace(":", "_").replace("/", "_")
+        r = CliRunner().invoke(main, ["render-all", str(src), "-o", str(out), "--size", "40x30", "--scheduler", scheduler])
+        assert r.exit_code == 0, r.output
+        pngs[scheduler] = {p.name: p.read_bytes() for p in sorted(out.iterdir())}
+    assert len(pngs[address]) == 8 + 2
+    assert pngs[address] == pngs["none"]

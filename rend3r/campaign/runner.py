@@ -17,7 +17,6 @@ the others; the results do not depend on where a task ran.
 from __future__ import annotations
 
 import logging
-import os
 from collections.abc import Callable, Sequence
 from types import TracebackType
 from typing import Any, TypeVar
@@ -58,14 +57,6 @@ def parse_scheduler(text: str) -> str:
     return value
 
 
-def machine_cores() -> int:
-    """The cores this process may run on (its CPU affinity where the OS tells it)."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
-
-
 def dask_installed() -> bool:
     """Whether ``dask.distributed`` can be imported (without importing it)."""
     from importlib.util import find_spec
@@ -104,9 +95,11 @@ class Campaign:
             return self
         from distributed import Client, LocalCluster
 
+        from ..emu.threads import available_cores
+
         try:
             if self.scheduler == LOCAL:
-                self._cluster = LocalCluster(n_workers=1, threads_per_worker=machine_cores(), processes=False,
+                self._cluster = LocalCluster(n_workers=1, threads_per_worker=available_cores(), processes=False,
                                              dashboard_address=None, silence_logs=logging.CRITICAL)
                 self._client = Client(self._cluster)
             else:

@@ -91,7 +91,7 @@ def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str
         if len({s.name for s in specs}) != len(specs):
             raise click.UsageError("two programs have the same name; results.csv keys rows by name")
         costs = {f: design_cost(f) for f in formats}
-        options = dict(subnormals=subnormals, width=width, height=height, jobs=jobs)
+        options = {"subnormals": subnormals, "width": width, "height": height, "jobs": jobs}
         pairs = [(spec, f) for spec in specs for f in formats]
         with Campaign(scheduler) as campaign, Progress(len(specs) + len(pairs), "explore", quiet=quiet) as bar:
             references = campaign.map(partial(render_design, precision=REFERENCE, **options), [(s,) for s in specs],

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import operator
-import threading
 import time
 
 import pytest
@@ -89,8 +88,8 @@ def test_without_dask_local_runs_serially_with_a_note(monkeypatch):
     with Campaign("local", note=notes.append) as campaign:
         assert not campaign.distributed
         assert campaign.map(slow_square, [(2,), (3,)], ["a", "b"], Counter()) == [4, 9]
-    assert notes == ["rend3r: note: Dask is not installed, running serially "
-                     "(pip install 'rend3r[campaign]' to use every core)"]
+    assert notes == [("rend3r: note: Dask is not installed, running serially "
+                      "(pip install 'rend3r[campaign]' to use every core)")]
     with pytest.raises(Rend3rError, match="--scheduler tcp://127.0.0.1:8786 needs Dask distributed"):
         Campaign("tcp://127.0.0.1:8786").__enter__()
 

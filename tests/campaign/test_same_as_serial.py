@@ -55,6 +55,6 @@ def test_a_failing_task_writes_nothing(tmp_path):
     out = tmp_path / "o" / "deeper"
     r = CliRunner().invoke(main, ["explore", str(PROGRAMS / "sphere.asm"), str(empty), "-o", str(out),
                                   "--size", "8x6", "--formats", "e4m3", "--scheduler", "local"])
-    assert (r.exit_code, r.output) == (1, "rend3r: error: empty in fp64: empty: rendered no frame "
-                                          "(no nf before the program ends)\n")
+    assert (r.exit_code, r.output) == (1, ("rend3r: error: empty in fp64: empty: rendered no frame "
+                                           "(no nf before the program ends)\n"))
     assert not (tmp_path / "o").exists()

@@ -8,7 +8,6 @@ import shutil
 import signal
 import socket
 import subprocess
-import sys
 from functools import partial
 from pathlib import Path
 
@@ -41,7 +40,7 @@ def cluster():
 
     address = f"tcp://127.0.0.1:{free_port()}"
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[2])}
-    quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "env": env}
     processes = [subprocess.Popen(["dask", "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
                                    "--no-dashboard"], **quiet)]
     try:
@@ -95,7 +94,7 @@ def test_a_worker_killed_mid_campaign_has_its_tasks_rerun(cluster):
 
     address, workers = cluster
     specs = [load_spec(PROGRAMS / n) for n in NAMES]
-    options = dict(subnormals="ftz", width=48, height=36, jobs=1)
+    options = {"subnormals": "ftz", "width": 48, "height": 36, "jobs": 1}
     references = [render_design(s, REFERENCE, **options) for s in specs]
     inputs = [(s, f, r) for s, r in zip(specs, references) for f in ("e4m3", "e5m6", "bf16", "e6m9", "fp24", "fp32")]
     names = [f"{s.name} in {f}" for s, f, _ in inputs]

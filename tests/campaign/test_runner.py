@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import operator
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
@@ -12,6 +15,8 @@ from rend3r.campaign import runner
 from rend3r.campaign.runner import Campaign, TaskFailed, parse_scheduler
 from rend3r.cli import main
 from rend3r.errors import Rend3rError
+
+PROGRAMS = Path(__file__).parents[2] / "programs"
 
 needs_dask = pytest.mark.skipif(not runner.dask_installed(),
                                 reason="Dask distributed is not installed (pip install 'rend3r[campaign]')")
@@ -141,3 +146,19 @@ def test_the_local_cluster_is_closed_with_the_run():
         assert campaign.map(slow_square, [(1,)], ["one"], Counter()) == [1]
     assert client.status == "closed" and scheduler.status.name == "closed"
     assert not campaign.distributed
+
+
+def test_dask_is_imported_only_when_a_cluster_is_used(tmp_path):
+    script = f"""
+import sys
+from click.testing import CliRunner
+from rend3r.cli import main
+for args in (["explore", "--help"], ["render-all", "--help"],
+             ["explore", {str(PROGRAMS / 'sphere.asm')!r}, "-o", {str(tmp_path)!r}, "--size", "8x6",
+              "--formats", "e4m3", "--scheduler", "none"]):
+    r = CliRunner().invoke(main, args)
+    assert r.exit_code == 0, r.output
+print(sorted(m for m in sys.modules if m.split(".")[0] in ("dask", "distributed")))
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False)
+    assert (done.returncode, done.stdout) == (0, "[]\n"), done.stderr

@@ -154,8 +154,9 @@ class Campaign:
             for future in as_completed(futures):
                 if future.status == "error":
                     raise TaskFailed(names[index[future.key]], future.exception())
-                if future.status == "cancelled":  # the scheduler gave up on it (or went away)
-                    raise Rend3rError(f"{names[index[future.key]]}: cancelled by the Dask scheduler")
+                if future.status == "cancelled":  # the scheduler went away, or gave up on the task
+                    raise Rend3rError(f"{names[index[future.key]]}: cancelled: the Dask scheduler went away "
+                                      "or gave up on it")
                 progress.advance(1)
             return self._client.gather(futures)
         except BaseException:

@@ -4,10 +4,12 @@ processes on 127.0.0.1, one of them killed in the middle of a campaign."""
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import signal
 import socket
 import subprocess
+import time
 from functools import partial
 from pathlib import Path
 
@@ -16,6 +18,7 @@ from click.testing import CliRunner
 
 from rend3r.campaign.runner import Campaign, dask_installed
 from rend3r.cli import main
+from rend3r.errors import Rend3rError
 
 pytestmark = [
     pytest.mark.skipif(not dask_installed(), reason="Dask distributed is not installed (pip install 'rend3r[campaign]')"),
@@ -34,7 +37,7 @@ def free_port() -> int:
 
 @pytest.fixture
 def cluster():
-    """``(address, workers)``: a scheduler and two one-thread workers without nannies (a
+    """``(address, processes)``: a scheduler and two one-thread workers without nannies (a
     killed worker stays dead), all stopped at the end."""
     from distributed import Client
 
@@ -49,7 +52,7 @@ def cluster():
                 processes.append(subprocess.Popen(["dask", "worker", address, "--name", name, "--nthreads", "1",
                                                    "--no-nanny", "--no-dashboard", "--host", "127.0.0.1"], **quiet))
             client.wait_for_workers(2, timeout=60)
-        yield address, processes[1:]
+        yield address, processes
     finally:
         for p in reversed(processes):
             p.terminate()
@@ -76,23 +79,23 @@ def test_explore_on_an_existing_cluster_matches_serial(tmp_path, cluster):
 
 
 class KillOnce:
-    """A progress bar that kills ``worker`` when the ``at``-th task has come back."""
+    """A progress bar that kills ``process`` when the ``at``-th task has come back."""
 
-    def __init__(self, worker: subprocess.Popen, at: int) -> None:
-        self.worker, self.at, self.done = worker, at, 0
+    def __init__(self, process: subprocess.Popen, at: int) -> None:
+        self.process, self.at, self.done = process, at, 0
 
     def advance(self, units: int) -> None:
         self.done += units
         if self.done == self.at:
-            self.worker.send_signal(signal.SIGKILL)
-            self.worker.wait(timeout=10)
+            self.process.send_signal(signal.SIGKILL)
+            self.process.wait(timeout=10)
 
 
 def test_a_worker_killed_mid_campaign_has_its_tasks_rerun(cluster):
     from rend3r.explore.campaign import REFERENCE, render_and_score, render_design
     from rend3r.explore.cli import load_spec
 
-    address, workers = cluster
+    address, (_, *workers) = cluster
     specs = [load_spec(PROGRAMS / n) for n in NAMES]
     options = {"subnormals": "ftz", "width": 48, "height": 36, "jobs": 1}
     references = [render_design(s, REFERENCE, **options) for s in specs]
@@ -123,3 +126,10 @@ def test_render_all_on_an_existing_cluster_matches_serial(tmp_path, cluster):
         pngs[scheduler] = {p.name: p.read_bytes() for p in sorted(out.iterdir())}
     assert len(pngs[address]) == 8 + 2
     assert pngs[address] == pngs["none"]
+
+
+def test_a_scheduler_that_goes_away_fails_the_run_by_task_name(cluster):
+    address, (scheduler, *_) = cluster
+    with Campaign(address) as campaign, pytest.raises(Rend3rError) as info:
+        campaign.map(time.sleep, [(0.2,)] * 20, [f"nap {i}" for i in range(20)], KillOnce(scheduler, at=2))
+    assert re.fullmatch(r"nap ([2-9]|1[0-9]): cancelled: the Dask scheduler went away or gave up on it", str(info.value))

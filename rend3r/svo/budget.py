@@ -6,11 +6,14 @@ every voxel a triangle touches; measured 1.45 on the bundled torus and sphere at
 5-10) plus three per unit of each triangle's longest edge (a sliver of no area still
 crosses a line of voxels), and a solid fill adds the enclosed volume (the absolute signed volume of the
 mesh, in voxels; measured within 13-26% of the fill). Peak memory is
-``SURFACE_BYTES`` per surface voxel (sorted Morton codes and the octree builder's
-arrays; peak RSS measured 50-79 bytes a voxel above the base for the torus at depths 10-11) and
-``FILL_BYTES`` per voxel of a solid fill (its coordinates are made before they are
-encoded; 103 measured at depth 8), plus a fixed ``BASE`` (the interpreter, numpy, one
-voxelising batch: 140 MB measured).
+``SURFACE_BYTES`` per surface voxel plus a fixed ``BASE`` (the interpreter, numpy, the
+mesh and one voxelising batch). The voxeliser holds 8 bytes a voxel (its sorted codes)
+and the octree builder, the peak, adds the masks and first-child indexes of the levels
+and the 4-byte words: peak RSS measured 20 bytes a voxel above a 35 MiB interpreter at
+depths 11-12, and ``BASE + SURFACE_BYTES * estimate`` came within +4% of the peak at
+depth 12 (torus 902 MiB, folded 1,717 MiB), +31% at depth 11 and +2% to +23% at depths
+8-10 (the estimate counts more voxels than there are). A solid fill adds ``FILL_BYTES``
+per fill voxel (its coordinates are made before they are encoded; 103 measured at depth 8).
 """
 
 from __future__ import annotations
@@ -23,9 +26,9 @@ import numpy as np
 from ..errors import Rend3rError
 
 SURFACE_FACTOR = 1.6
-SURFACE_BYTES = 80
+SURFACE_BYTES = 16
 FILL_BYTES = 100
-BASE = 160 << 20
+BASE = 125 << 20
 _UNITS = {"": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
 _SIZE = re.compile(r"\s*([0-9]+(?:\.[0-9]*)?)\s*([KMGT]?)(?:I?B)?\s*", re.IGNORECASE)
 
@@ -66,7 +69,7 @@ def check_budget(voxels: tuple[int, int], budget: int, what: str) -> None:
     surface, fill = voxels
     need = BASE + SURFACE_BYTES * surface + FILL_BYTES * fill
     if need > budget:
-        raise Rend3rError(f"{what}: about {surface + fill:,} voxels need an estimated {need / 2**30:.1f} GiB, "
+        raise Rend3rError(f"{what}: about {surface + fill:,} voxels need an estimated {need / 2**30:.2f} GiB at peak, "
                           f"over the memory budget of {budget / 2**30:.1f} GiB (--max-memory; "
                           "use a smaller --depth)")
 

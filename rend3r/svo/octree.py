@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 
@@ -116,7 +117,7 @@ def _blocks(children: np.ndarray) -> list[tuple[int, int]]:
         stop = bounds[-1] + _BLOCK
         bounds.append(len(children) if stop >= len(children)
                       else int(np.searchsorted(children, (children[stop] >> 3) << 3)))
-    return list(zip(bounds, bounds[1:]))
+    return list(pairwise(bounds))
 
 
 def _heads(children: np.ndarray) -> np.ndarray:

@@ -152,3 +152,53 @@ def test_svo_build_of_a_degenerate_obj_is_a_clean_error(tmp_path):
     r = CliRunner().invoke(main, ["svo", "build", str(obj), "-o", str(tmp_path / "x.svo"), "--depth", "3"])
     assert r.exit_code == 1 and f"{obj}: mesh has no area" in r.output, r.output
     assert not (tmp_path / "x.svo").exists()
+
+
+# (voxels, words, first 16 hex digits of the words' SHA-256) of the builder before the
+# depth-12 memory work (commit c4e3241): the lean builder writes the same bytes
+_BEFORE = {
+    ("torus", 8, False, 15): (174936, 65029, "3cdb8044f9c8c28c"),
+    ("torus", 8, False, 4): (174936, 74176, "65968755929e4089"),
+    ("folded", 7, False, 15): (84440, 27255, "64faf83a26474610"),
+    ("folded", 7, False, 4): (84440, 33735, "95b9827985324430"),
+    ("sphere", 6, True, 15): (130480, 20505, "26b684512bf56567"),
+    ("sphere", 6, True, 4): (130480, 23456, "d7057282f0e25cee"),
+}
+
+
+@pytest.mark.parametrize("block", [1 << 22, 61], ids=["one-block", "many-blocks"])
+@pytest.mark.parametrize("key", list(_BEFORE), ids=lambda k: "-".join(map(str, k)))
+def test_octree_bytes_unchanged_by_the_memory_work(key, block, monkeypatch):
+    import hashlib
+
+    from rend3r.svo import octree
+    from rend3r.svo.models import make_model
+    from rend3r.svo.octree import build_octree_codes
+
+    monkeypatch.setattr(octree, "_BLOCK", block)  # levels derived in blocks ending on parent boundaries
+    from rend3r.svo.voxelize import voxelize_codes
+
+    name, depth, solid, ptr_bits = key
+    codes, _, _ = voxelize_codes(*make_model(name), depth, solid)
+    words = build_octree_codes(codes, depth, ptr_bits).words
+    digest = hashlib.sha256(words.astype("<u4").tobytes()).hexdigest()[:16]
+    assert (len(codes), len(words), digest) == _BEFORE[key]
+
+
+def test_budget_deduplication_mid_stream_keeps_the_result(monkeypatch):
+    """A voxel limit just above the count deduplicates the growing buffer between batches."""
+    from rend3r.svo import voxelize as vox
+    from rend3r.svo.voxelize import voxelize_surface
+
+    v, f = torus(32)
+    lo, h = fit_bounds(v, 6)
+    tri = (v[f] - lo) / h
+    whole = voxelize_surface(tri, 64)
+    monkeypatch.setattr(vox, "_CHUNK", 256)  # many small batches: keys repeat between them
+    calls = []
+    dedupe = vox._dedupe
+    monkeypatch.setattr(vox, "_dedupe", lambda values, count: calls.append(count) or dedupe(values, count))
+    assert np.array_equal(voxelize_surface(tri, 64, max_voxels=len(whole)), whole)
+    assert len(calls) > 1
+    with pytest.raises(Rend3rError, match="more than"):
+        voxelize_surface(tri, 64, max_voxels=len(whole) - 1)

@@ -212,13 +212,9 @@ def _build(codes: np.ndarray, depth: int, ptr_bits: int, advance: Callable[[int]
                 break
             far[lvl] |= need
         below = before
-    words = np.zeros(counts[-1] + sum(int(f.sum()) for f in far[:-1]) + sum(counts[:-1]), dtype=np.uint32)
+    words = np.zeros(sum(counts) + sum(int(f.sum()) for f in far), dtype=np.uint32)
     region = 0
-    for lvl in range(depth):
-        if lvl == depth - 1:  # leaves only: leaf mask = valid mask, no pointer
-            words[region:region + counts[lvl]] = valid[lvl].astype(np.uint32) * 257
-            advance(1)
-            break
+    for lvl in range(depth - 1):
         before = _far_before(far[lvl])
         below = _far_before(far[lvl + 1])
         group, end = _siblings(valid, first, lvl)
@@ -233,6 +229,8 @@ def _build(codes: np.ndarray, depth: int, ptr_bits: int, advance: Callable[[int]
         words[slot[is_far]] = rel[is_far]
         region += counts[lvl] + int(before[-1])
         advance(1)
+    words[region:] = valid[-1].astype(np.uint32) * 257  # the deepest level: leaf mask = valid mask, no pointer
+    advance(1)
     return Octree(words, depth, ptr_bits)
 
 

@@ -11,7 +11,7 @@ mesh and one voxelising batch). The voxeliser holds 8 bytes a voxel (its sorted 
 and the octree builder, the peak, adds the masks and first-child indexes of the levels
 and the 4-byte words: peak RSS measured 20 bytes a voxel above a 35 MiB interpreter at
 depths 11-12, and ``BASE + SURFACE_BYTES * estimate`` came within +4% of the peak at
-depth 12 (torus 902 MiB, folded 1,717 MiB), +31% at depth 11 and +2% to +23% at depths
+depth 12 (torus 902 MiB, folded 1,714 MiB), +31% at depth 11 and +2% to +23% at depths
 8-10 (the estimate counts more voxels than there are). A solid fill adds ``FILL_BYTES``
 per fill voxel (its coordinates are made before they are encoded; 103 measured at depth 8).
 """

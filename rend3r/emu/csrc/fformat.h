@@ -8,8 +8,9 @@
  * from its exact error (TwoSum, Dekker's TwoProduct, the residual of a quotient or a
  * square root): an inexact result whose last bit is even moves one ulp towards the exact
  * value. Rounding a round-to-odd value to nearest at a precision at least two bits shorter
- * gives the correctly rounded result (Boldo and Melquiond 2008), so every M <= 51 rounds
- * correctly in the normal range. Results below the smallest normal number are rounded to
+ * gives the correctly rounded result (Boldo and Melquiond 2008), so every M <= 50 rounds
+ * correctly; M = 51 has one bit to spare and settles its midpoints from the error's sign
+ * instead (to_side4). Results below the smallest normal number are rounded to
  * the subnormal grid by adding and subtracting a power of two; ftz then flushes what is
  * still below it (so values that round up to the smallest normal number keep it, as in
  * the fp16 kernels and rend3r/precision/rounding.py), or, judging tininess before
@@ -60,6 +61,21 @@ static inline f64x4 to_odd4(f64x4 d, f64x4 e)
     return (f64x4)SEL_BITS((u64x4)move, stepped, b);
 }
 
+/* For M = 51 double keeps one bit more than the format, too few for round to odd in the
+ * normal range: there an inexact d whose last bit is set lies on a midpoint of the format,
+ * and one ulp towards the exact value (d + e) settles the rounding; below 2**emin the
+ * format keeps fewer bits and round to odd applies. */
+static inline f64x4 to_side4(f64x4 d, f64x4 e)
+{
+    if (format_now.drop > 1)
+        return to_odd4(d, e);
+    u64x4 b = (u64x4)d, a = b & ~F64_SIGN;
+    i64x4 move = ((e < 0) | (e > 0)) & ((b & 1) == 1) & ((i64x4)a < (int64_t)F64_INF);
+    i64x4 away = (i64x4)(((u64x4)e ^ b) & F64_SIGN) == 0;
+    u64x4 normal = SEL_BITS((u64x4)move, SEL_BITS((u64x4)away, b + 1, b - 1), b);
+    return (f64x4)SEL_BITS((u64x4)((i64x4)a < (int64_t)format_now.min_normal_bits), (u64x4)to_odd4(d, e), normal);
+}
+
 /* Dekker's TwoProduct without a fused multiply-add: x*y = p + e exactly (no overflow). */
 static inline f64x4 product_error4(f64x4 x, f64x4 y, f64x4 p)
 {
@@ -74,7 +90,7 @@ static inline f64x4 format_add4(f64x4 a, f64x4 b)
     f64x4 d = a + b;
     if (format_now.wide) {
         f64x4 bv = d - a;
-        d = to_odd4(d, (a - (d - bv)) + (b - bv));
+        d = to_side4(d, (a - (d - bv)) + (b - bv));
     }
     return round_format4(d);
 }
@@ -83,7 +99,7 @@ static inline f64x4 format_mul4(f64x4 a, f64x4 b)
 {
     f64x4 d = a * b;
     if (format_now.wide)
-        d = to_odd4(d, product_error4(a, b, d));
+        d = to_side4(d, product_error4(a, b, d));
     return round_format4(d);
 }
 
@@ -93,7 +109,7 @@ static inline f64x4 format_div4(f64x4 a, f64x4 b)
     f64x4 d = a / b;
     if (format_now.wide) {
         f64x4 p = d * b, r = (a - p) - product_error4(d, b, p);
-        d = to_odd4(d, (f64x4)((u64x4)r ^ ((u64x4)b & F64_SIGN)));
+        d = to_side4(d, (f64x4)((u64x4)r ^ ((u64x4)b & F64_SIGN)));
     }
     return round_format4(d);
 }
@@ -106,7 +122,7 @@ static inline f64x4 format_sqrt4(f64x4 a)
         d[i] = sqrt(a[i]);
     if (format_now.wide) {
         f64x4 p = d * d;
-        d = to_odd4(d, (a - p) - product_error4(d, d, p));
+        d = to_side4(d, (a - p) - product_error4(d, d, p));
     }
     return round_format4(d);
 }

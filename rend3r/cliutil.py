@@ -3,6 +3,7 @@ memory budgets."""
 
 from __future__ import annotations
 
+import importlib
 import os
 import re
 
@@ -53,24 +54,25 @@ SIZE = SizeType()
 DEVICE_SIZE = "512x384"
 
 
-class PrecisionType(click.ParamType):
-    """``--precision``: a working format's name, checked and made canonical (bad names exit 2).
-    The emulator's arithmetic module is imported only when a value is converted."""
+class CheckedType(click.ParamType):
+    """A value checked and made canonical by ``"module:function"`` (ValueError: the value is
+    bad, exit 2), imported only when a value is converted, so ``--help`` stays fast."""
 
-    name = "FORMAT"
+    def __init__(self, name: str, checker: str) -> None:
+        self.name, self._checker = name, checker
 
     def convert(self, value, param, ctx) -> str:
-        from .emu.arith import precision_name
-
+        module, function = self._checker.split(":")
+        check = getattr(importlib.import_module(module), function)
         try:
-            return precision_name(str(value))
+            return check(str(value))
         except ValueError as exc:
             self.fail(str(exc), param, ctx)
 
 
 #: ``--precision FORMAT``: the emulator's working precision.
 PRECISION = click.option(
-    "--precision", type=PrecisionType(), default="fp16", show_default=True,
+    "--precision", type=CheckedType("FORMAT", "rend3r.emu.arith:precision_name"), default="fp16", show_default=True,
     help="Working precision: fp16 (the device), fp32, fp64, or any binary format eEmM (E exponent bits 2..11, "
          "M fraction bits 1..52) or alias bf16, tf32, fp24 (docs/precision.md).")
 

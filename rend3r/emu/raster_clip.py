@@ -56,7 +56,6 @@ class Clipped:
 
 def clip_triangles(ar: Arith, tris: np.ndarray, planes: ClipPlanes) -> Clipped:
     """Clip camera-space triangles ``tris`` (N, 3, 3) to the view volume."""
-    n = tris.shape[0]
     d = planes.distances(ar, tris)  # (N, 3, 5)
     inside = d >= 0  # NaN counts as outside
     all_in = inside.all(axis=(1, 2))

@@ -17,7 +17,7 @@ from ..isa.float16 import float_to_bits
 from ..isa.tables import SHAPE_TYPE_CODES
 from .arith import Arith
 from .scene import Scene, prop_index
-from .vec import Quat, Vec, dot, madd3, mul3, rotate, rotate_inverse, sub3
+from .vec import Quat, Vec, madd3, mul3, rotate, rotate_inverse, sub3
 
 #: z-term sign and constant of each shape type's normal form: x^2 + y^2 + zsign*z^2 = one.
 NORMAL_FORMS = {SHAPE_TYPE_CODES[name]: form for name, form in (

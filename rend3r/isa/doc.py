@@ -115,7 +115,7 @@ def value_tables() -> str:
     shapes = ", ".join(f"{k} {v}" for k, v in SHAPE_TYPES.items())
     return "\n".join(
         [
-            f"- Opcodes (bits 2:0): " + ", ".join(f"{op.name} = {op.value:03b}" for op in Opcode) + f"; unused: {unused}.",
+            "- Opcodes (bits 2:0): " + ", ".join(f"{op.name} = {op.value:03b}" for op in Opcode) + f"; unused: {unused}.",
             f"- F-type functions (bits 10:9): {funcs}.",
             f"- Light `src` (low 2 bits): {sources}.",
             f"- Shape `type` (4 bits): {shapes}; other values draw nothing.",

@@ -79,18 +79,20 @@ def _at(v: np.ndarray, lanes: np.ndarray) -> np.ndarray:
     return v.reshape(-1)[lanes]
 
 
-def _operands(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
+def _binary(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float, op: np.ufunc,
+            side: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray], tininess: Tininess) -> np.ndarray:
+    """``op(a, b)`` in float64, rounded as the exact result would be (``side(x, y, r)``: the
+    sign of exact - r on the lanes given)."""
     x, y = np.broadcast_arrays(read(fmt, a), read(fmt, b))
-    return x, y
+    with np.errstate(all="ignore"):
+        r = op(x, y)
+        return _finish(fmt, r, lambda i: side(_at(x, i), _at(y, i), _at(r, i)), tininess)
 
 
 def add(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float, *,
         tininess: Tininess = "after") -> np.ndarray:
     """``a + b`` correctly rounded to ``fmt``."""
-    x, y = _operands(fmt, a, b)
-    with np.errstate(all="ignore"):
-        r = np.add(x, y)
-        return _finish(fmt, r, lambda i: exact.sum_side(_at(x, i), _at(y, i), _at(r, i)), tininess)
+    return _binary(fmt, a, b, np.add, exact.sum_side, tininess)
 
 
 def sub(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float, *,
@@ -102,19 +104,13 @@ def sub(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float, *,
 def mul(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float, *,
         tininess: Tininess = "after") -> np.ndarray:
     """``a * b`` correctly rounded to ``fmt``."""
-    x, y = _operands(fmt, a, b)
-    with np.errstate(all="ignore"):
-        r = np.multiply(x, y)
-        return _finish(fmt, r, lambda i: exact.product_side(_at(x, i), _at(y, i), _at(r, i)), tininess)
+    return _binary(fmt, a, b, np.multiply, exact.product_side, tininess)
 
 
 def div(fmt: FloatFormat, a: np.ndarray | float, b: np.ndarray | float, *,
         tininess: Tininess = "after") -> np.ndarray:
     """``a / b`` correctly rounded to ``fmt``."""
-    x, y = _operands(fmt, a, b)
-    with np.errstate(all="ignore"):
-        r = np.divide(x, y)
-        return _finish(fmt, r, lambda i: exact.quotient_side(_at(x, i), _at(y, i), _at(r, i)), tininess)
+    return _binary(fmt, a, b, np.divide, exact.quotient_side, tininess)
 
 
 def sqrt(fmt: FloatFormat, a: np.ndarray | float, *, tininess: Tininess = "after") -> np.ndarray:

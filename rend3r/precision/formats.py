@@ -33,7 +33,7 @@ ALIASES: dict[str, tuple[int, int]] = {
     "fp32": (8, 23),
     "fp64": (11, 52),
 }
-_SPEC = re.compile(r"e(?P<e>\d+)m(?P<m>\d+)")
+_SPEC = re.compile(r"e(?P<e>\d{1,4})m(?P<m>\d{1,4})")  # widths checked below; few digits: no huge ints
 
 
 class FormatError(ValueError):
@@ -126,10 +126,11 @@ def parse(text: str, subnormals: Subnormals = "ieee") -> FloatFormat:
     Raises :class:`FormatError` naming the part that is wrong and the allowed values.
     """
     spec = text.strip().lower()
+    shown = repr(text if len(text) <= 40 else text[:37] + "...")  # what errors quote of it
     base, _, mode = spec.partition("-")
     if mode:
         if mode not in SUBNORMAL_MODES:
-            raise FormatError(f"bad format {text!r}: subnormal mode {mode!r} must be ftz or ieee")
+            raise FormatError(f"bad format {shown}: subnormal mode {mode[:12]!r} must be ftz or ieee")
         subnormals = mode  # type: ignore[assignment]
     if base in ALIASES:
         e, m = ALIASES[base]
@@ -137,7 +138,7 @@ def parse(text: str, subnormals: Subnormals = "ieee") -> FloatFormat:
         match = _SPEC.fullmatch(base)
         if match is None:
             raise FormatError(
-                f"bad format {text!r}: expected eEmM (E exponent bits {EXP_BITS[0]}..{EXP_BITS[-1]}, "
+                f"bad format {shown}: expected eEmM (E exponent bits {EXP_BITS[0]}..{EXP_BITS[-1]}, "
                 f"M fraction bits {FRAC_BITS[0]}..{FRAC_BITS[-1]}, e.g. e5m10) or one of "
                 f"{', '.join(ALIASES)}, optionally with -ftz or -ieee"
             )
@@ -145,4 +146,4 @@ def parse(text: str, subnormals: Subnormals = "ieee") -> FloatFormat:
     try:
         return FloatFormat(e, m, subnormals)
     except FormatError as err:
-        raise FormatError(f"bad format {text!r}: {err}") from None
+        raise FormatError(f"bad format {shown}: {err}") from None

@@ -7,12 +7,17 @@ import shlex
 import sys
 from functools import partial
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from ..campaign.options import SCHEDULER
-from ..cliutil import JOBS, SIZE
+from ..cliutil import JOBS, MAX_MEMORY, SIZE, default_memory
+from ..errors import Rend3rError
 from ..progress import Progress, quiet_option
+
+if TYPE_CHECKING:
+    from .campaign import ProgramSpec
 
 DEFAULT_FORMATS = "fp16,bf16,tf32,fp24,fp32"
 
@@ -58,9 +63,11 @@ def load_spec(path: Path):
               help="PSNR against fp64 a format must reach to serve a program.")
 @JOBS
 @SCHEDULER
+@MAX_MEMORY
 @quiet_option
 def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str], subnormals: str,
-                    size: tuple[int, int], min_psnr: float, jobs: int, scheduler: str, quiet: bool) -> None:
+                    size: tuple[int, int], min_psnr: float, jobs: int, scheduler: str, max_memory: int | None,
+                    quiet: bool) -> None:
     """Which uniform number format each PROGRAM needs, and what each format costs.
 
     Renders every program in every format of LIST and in fp64, scores each against
@@ -90,6 +97,7 @@ def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str
         specs = [load_spec(p) for p in programs]
         if len({s.name for s in specs}) != len(specs):
             raise click.UsageError("two programs have the same name; results.csv keys rows by name")
+        _check_memory(specs, width, height, scheduler, max_memory or default_memory())
         costs = {f: design_cost(f) for f in formats}
         options = {"subnormals": subnormals, "width": width, "height": height, "jobs": jobs}
         pairs = [(spec, f) for spec in specs for f in formats]
@@ -108,3 +116,21 @@ def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str
         out.commit()
     if not quiet:
         click.echo(f"explore: {len(specs)} program(s) x {len(formats)} format(s) at {width}x{height} -> {out_dir}")
+
+
+def _check_memory(specs: list[ProgramSpec], width: int, height: int, scheduler: str, budget: int) -> None:
+    """Refuse, before any rendering, a campaign estimated to exceed ``budget`` bytes here: the
+    fp64 references kept for scoring (RGB565 and provenance, 6 bytes a pixel and frame), and
+    on a local cluster one design's frames being rendered on every core at once."""
+    from ..emu.budget import BASE, ENGINE, FRAME
+    from ..emu.threads import available_cores
+
+    pixels = width * height
+    kept = sum(s.frames for s in specs) * pixels * 6
+    render = max(ENGINE.get(s.mode, max(ENGINE.values())) + FRAME * s.frames for s in specs) * pixels
+    renders = available_cores() if scheduler == "local" else 1
+    need = BASE + kept + renders * render
+    if need > budget:
+        raise Rend3rError(f"explore at {width}x{height} needs about {need / 2**30:.2f} GiB here ({len(specs)} "
+                          f"program(s), {renders} render(s) at once); the memory budget is {budget / 2**30:.2f} GiB "
+                          "(--max-memory): use a smaller --size or fewer programs, or raise the budget")

@@ -124,3 +124,14 @@ def test_identical_formats_score_inf(tmp_path):
     assert r.exit_code == 0 and r.output == ""
     row = next(csv.DictReader((tmp_path / "results.csv").read_text().splitlines()))
     assert math.isinf(float(row["psnr_db"])) and row["max_channel"] == "0"
+
+
+def test_a_campaign_over_the_memory_budget_is_refused_before_rendering(tmp_path):
+    """8192x8192 keeps 6 bytes a pixel of fp64 reference per program: over 1 GiB it is
+    refused up front, with the estimate and the option named, and nothing is written."""
+    out = tmp_path / "x"
+    r = CliRunner().invoke(main, ["explore", str(PROGRAMS / "sphere.asm"), str(PROGRAMS / "shadow.asm"), "-o",
+                                  str(out), "--size", "8192x8192", "--max-memory", "1G", "--scheduler", "none"])
+    assert r.exit_code == 1
+    assert "GiB" in r.output and "--max-memory" in r.output
+    assert not out.exists()

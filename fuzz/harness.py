@@ -1,8 +1,13 @@
 """Run CLI cases in child processes and tally what the reliability report needs.
 
 Each case is one ``python -m rend3r ...`` child, so a crash (a signal) is seen as a crash
-and not as the end of the fuzzer, and each child's own time and peak RSS are measured
-(``os.wait4`` gives the child's resource usage). A case *passes* when the command exits
+and not as the end of the fuzzer, and each child's own time and peak RSS are measured.
+The peak comes from a small starter process (:data:`_STARTER`, ``python -S``) that forks
+the case and reports its ``wait4`` usage: Linux folds the memory of the process that
+calls ``exec`` into the new program's ``ru_maxrss``, and a child forked (or
+``posix_spawn``-ed, which shares its memory until ``exec``) straight from the fuzzer
+reported the fuzzer's own peak, hundreds of MiB after a long run. The starter holds about
+10 MiB, below any case. A case *passes* when the command exits
 0, 1 or 2 and its stderr holds no Python traceback; exit 1 and 2 must come with an
 ``error:`` line, except the exits a command documents as verdicts (``verdicts``: e.g.
 ``trace-diff``'s 1, "traces differ", printed on standard output). Limits: ``timeout`` seconds (a hang is reported, not waited on) and
@@ -16,7 +21,6 @@ in-process with a fixed budget.
 from __future__ import annotations
 
 import os
-import resource
 import signal
 import subprocess
 import sys
@@ -67,35 +71,48 @@ def run_case(args: list[str], *, stdin: bytes | None = None, cwd: str | Path | N
     """Run ``python -m rend3r *args`` in a child and measure its time and its own peak RSS
     (``verdicts``: exit statuses that are documented answers, not errors)."""
 
-    def limit() -> None:
-        resource.setrlimit(resource.RLIMIT_AS, (max_rss, max_rss))
-
-    with tempfile.TemporaryFile() as err, tempfile.TemporaryFile() as given:
+    with tempfile.TemporaryFile() as err, tempfile.TemporaryFile() as given, \
+            tempfile.TemporaryFile() as report:
         if stdin is not None:
             given.write(stdin)
             given.seek(0)
         start = time.perf_counter()
-        child = subprocess.Popen([sys.executable, "-m", "rend3r", *args], cwd=cwd,
-                                 stdin=given if stdin is not None else subprocess.DEVNULL,
-                                 stdout=subprocess.DEVNULL, stderr=err,
-                                 preexec_fn=limit, start_new_session=True)
-        timed_out = False
-        while True:
-            pid, status, usage = os.wait4(child.pid, os.WNOHANG)
-            if pid:
-                break
-            if time.perf_counter() - start > timeout:
-                timed_out = True
-                os.killpg(child.pid, signal.SIGKILL)
-                pid, status, usage = os.wait4(child.pid, 0)
-                break
-            time.sleep(0.005)
+        starter = subprocess.Popen([sys.executable, "-S", "-c", _STARTER, str(max_rss),
+                                    sys.executable, "-m", "rend3r", *args], cwd=cwd,
+                                   stdin=given if stdin is not None else subprocess.DEVNULL,
+                                   stdout=report, stderr=err, start_new_session=True)
+        try:
+            starter.wait(timeout)
+            timed_out = False
+        except subprocess.TimeoutExpired:
+            timed_out = True
+            os.killpg(starter.pid, signal.SIGKILL)  # the case is in the starter's session
+            starter.wait()
         seconds = time.perf_counter() - start
-        child.returncode = os.waitstatus_to_exitcode(status)  # reaped here, not by Popen
+        report.seek(0)
+        measured = report.read().split()
         err.seek(0)
         text = err.read().decode("utf-8", "replace")
-    return CaseResult(tuple(args), child.returncode, seconds, usage.ru_maxrss * 1024, text,
-                      timed_out, verdicts)
+    if timed_out or len(measured) != 2:  # killed before the case ended: no usage to report
+        return CaseResult(tuple(args), -signal.SIGKILL, seconds, 0, text, True, verdicts)
+    status, rss_kib = (int(x) for x in measured)
+    return CaseResult(tuple(args), os.waitstatus_to_exitcode(status), seconds, rss_kib * 1024, text,
+                      False, verdicts)
+
+
+_STARTER = """
+import os, resource, sys
+pid = os.fork()
+if pid == 0:
+    os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
+    limit = int(sys.argv[1])
+    resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    os.execv(sys.argv[2], sys.argv[2:])
+_, status, usage = os.wait4(pid, 0)
+print(status, usage.ru_maxrss)
+"""
+"""Run by ``python -S -c``: fork the case (address space limited to ``argv[1]`` bytes,
+standard output discarded), wait, and print its wait status and its own peak RSS in KiB."""
 
 
 @dataclass

@@ -32,6 +32,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "trace-diff": ("rend3r.emu.trace_diff:trace_diff_command", "Compare two float16 pixel traces; report the first divergence."),
     "explore": ("rend3r.explore.cli:explore_command", "Which uniform number format each program needs, and its hardware cost."),
     "svo": ("rend3r.svo.cli:svo_group", "Sparse voxel octrees: build from meshes, trace in 16.16 fixed point, sweep cache/core designs."),
+    "view": ("rend3r.view.cli:view_command", "Inspect a program in the browser: frames, pixel history, live reload."),
 }
 
 

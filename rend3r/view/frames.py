@@ -1,0 +1,164 @@
+"""A REND3R program's frames, their difference from fp64, and pixel histories, all from
+the emulator's own functions (:func:`run_program`, :func:`trace_raytrace`,
+:func:`trace_raster`): the view shows what ``rend3r emulate`` computes."""
+
+from __future__ import annotations
+
+import io
+import warnings
+from collections import OrderedDict
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import replace
+
+import numpy as np
+
+from .params import MAX_FRAMES, RequestError
+
+#: Bytes of rendered frames kept for reuse (older option sets are dropped first).
+CACHE_BYTES = 128 << 20
+#: A pixel history lists every shape's stages up to this many shapes; beyond it, the
+#: shapes that were hit (in either precision) unless all are asked for.
+ALL_SHAPES_UP_TO = 64
+
+
+@contextmanager
+def quiet_numpy() -> Iterator[None]:
+    """Extreme values are the renderer's documented input (``rend3r emulate`` hides numpy's
+    warnings about them the same way)."""
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        yield
+
+
+def png(rgb888: np.ndarray) -> bytes:
+    """An (H, W, 3) uint8 image as PNG bytes."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(rgb888, "RGB").save(buf, format="PNG")
+    return buf.getvalue()
+
+
+def frame_count(words: Sequence[int], options) -> int:
+    """Frames the program renders (a looping program: :data:`MAX_FRAMES`)."""
+    from ..emu.processor import execute
+
+    count = execute(words, options, MAX_FRAMES).frames
+    if count == 0:
+        raise RequestError("the program renders no frame (no nf is executed)", 422)
+    return count
+
+
+class FrameCache:
+    """Rendered frames (RGB565) per (program version, options), least recently used dropped
+    first beyond :data:`CACHE_BYTES`."""
+
+    def __init__(self, budget: int = CACHE_BYTES) -> None:
+        self.budget = budget
+        self._frames: OrderedDict[tuple, list[np.ndarray]] = OrderedDict()
+
+    def frame(self, version: int, words: Sequence[int], options, number: int) -> np.ndarray:
+        """Frame ``number`` of the program (its frames up to it are rendered and kept)."""
+        from ..emu.run import run_program
+
+        key = (version, options)
+        frames = self._frames.get(key)
+        if frames is None or len(frames) <= number:
+            frames = []
+            with quiet_numpy():
+                run_program(words, options, number + 1, lambda f: frames.append(f.rgb565), keep_frames=False)
+            self._frames[key] = frames
+        self._frames.move_to_end(key)
+        while len(self._frames) > 1 and sum(f.nbytes for fs in self._frames.values() for f in fs) > self.budget:
+            self._frames.popitem(last=False)
+        return frames[number]
+
+
+def reference(options):
+    """The same options in fp64: the clean picture the scene describes."""
+    return replace(options, precision="fp64")
+
+
+def difference(work: np.ndarray, ref: np.ndarray) -> tuple[np.ndarray, dict]:
+    """A heatmap of two RGB888 frames (black: equal; dark red to yellow: the largest channel
+    difference, 1 to 255) and its figures."""
+    d = np.abs(work.astype(np.int16) - ref.astype(np.int16)).max(axis=2)
+    heat = np.zeros(work.shape, dtype=np.uint8)
+    differs = d > 0
+    heat[..., 0] = np.where(differs, 96 + d * 159 // 255, 0)
+    heat[..., 1] = np.clip(2 * d - 255, 0, 255)
+    return heat, {"differing_pixels": int(differs.sum()), "max_difference": int(d.max(initial=0)),
+                  "pixels": int(d.size)}
+
+
+def trace(words: Sequence[int], options, frame: int, x: int, y: int) -> list[dict]:
+    """The records ``rend3r emulate --trace-pixel X,Y`` prints for frame ``frame``."""
+    from ..emu.processor import execute
+    from ..emu.trace import trace_raster, trace_raytrace
+
+    if options.mode == "hybrid":
+        raise RequestError("hybrid frames have no pixel trace (docs/trace.md)", 422)
+    tracer = trace_raster if options.mode == "raster" else trace_raytrace
+    out: list[dict] = []
+
+    def on_nf(scene, number: int) -> None:
+        if number == frame:
+            tracer(scene, options, number, [(x, y)], out.append)
+
+    with quiet_numpy():
+        execute(words, options, frame + 1, on_nf)
+    return out
+
+
+def _occurrences(records: list[dict]) -> Iterator[tuple]:
+    """(shape, stage, occurrence) of each record, as ``rend3r trace-diff`` matches them."""
+    seen: dict[tuple, int] = {}
+    for r in records:
+        k = (r["shape"], r["stage"])
+        seen[k] = seen.get(k, -1) + 1
+        yield (*k, seen[k])
+
+
+def _agreement(ar, work: list[dict], ref: list[dict]) -> list[tuple[dict | None, bool]]:
+    """Each working record's fp64 record (matched by shape, stage and occurrence, as
+    ``rend3r trace-diff`` matches) and whether the two agree: integers and flags equal,
+    values equal to the fp64 value rounded to the working format (NaN agrees with NaN)."""
+    by_key = dict(zip(_occurrences(ref), ref))
+    pairs = [by_key.get(key) for key in _occurrences(work)]
+    agree = [f is not None and (not isinstance(r["dec"], int) or r["dec"] == f["dec"]) for r, f in zip(work, pairs)]
+    values = [i for i, (r, f) in enumerate(zip(work, pairs)) if f is not None and not isinstance(r["dec"], int)]
+    if values:
+        a = np.array([float(work[i]["dec"]) for i in values])  # "nan", "inf" and "-inf" read as themselves
+        b = np.asarray(ar.round(np.array([float(pairs[i]["dec"]) for i in values])), dtype=np.float64)
+        for i, ok in zip(values, ((a == b) | (np.isnan(a) & np.isnan(b))).tolist()):
+            agree[i] = ok
+    return list(zip(pairs, agree))
+
+
+def history(words: Sequence[int], options, frame: int, x: int, y: int, all_shapes: bool) -> dict:
+    """A pixel's trace records, each with its fp64 record beside it and whether the two
+    disagree; the first disagreeing value and the first disagreeing decision (an integer
+    or flag: hit, nearest, shadow, colour) are marked."""
+    if not (0 <= x < options.width and 0 <= y < options.height):
+        raise RequestError(f"pixel {x},{y} is outside the {options.width}x{options.height} frame")
+    work = trace(words, options, frame, x, y)
+    ref = trace(words, reference(options), frame, x, y)
+    ar = options.arith
+    rows = [{**r, "fp64": None if f is None else {"hex": f["hex"], "dec": f["dec"]}, "diverges": not ok}
+            for r, (f, ok) in zip(work, _agreement(ar, work, ref))]
+    first = next((i for i, r in enumerate(rows) if r["diverges"]), None)
+    decision = next((i for i, r in enumerate(rows) if r["diverges"] and isinstance(r["dec"], int)), None)
+    split = next((i for i, r in enumerate(rows) if r["stage"] == "nearest"), len(rows))
+    shapes = {r["shape"] for r in rows[:split]}
+    keep = shapes
+    if len(shapes) > ALL_SHAPES_UP_TO and not all_shapes:
+        marked = [rows[i]["shape"] for i in (first, decision) if i is not None and i < split]
+        keep = {r["shape"] for r in work + ref if r["stage"] == "hit" and r["dec"] == 1}
+        keep |= {r["dec"] for r in work + ref if r["stage"] == "nearest"} | set(marked)
+    shown = [r for r in rows[:split] if r["shape"] in keep] + rows[split:]
+    index = {id(r): i for i, r in enumerate(shown)}
+    return {"frame": frame, "pixel": [x, y], "precision": options.precision, "label": ar.label,
+            "mode": options.mode, "shapes": len(shapes), "shapes_shown": len(keep & shapes), "records": shown,
+            "first_divergence": None if first is None else index[id(rows[first])],
+            "first_decision": None if decision is None else index[id(rows[decision])]}

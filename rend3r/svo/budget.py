@@ -64,10 +64,11 @@ def estimate_voxels(tri_grid: np.ndarray, n: int, solid: bool) -> tuple[int, int
     return int(min(surface, cap)), int(min(fill, cap))
 
 
-def check_budget(voxels: tuple[int, int], budget: int, what: str) -> None:
-    """Refuse, with the estimate, a build of (surface, fill) voxels that would exceed ``budget`` bytes."""
+def check_budget(voxels: tuple[int, int], budget: int, what: str, held: int = 0) -> None:
+    """Refuse, with the estimate, a build of (surface, fill) voxels that would exceed ``budget``
+    bytes (``held``: bytes kept besides, such as a binvox file's)."""
     surface, fill = voxels
-    need = BASE + SURFACE_BYTES * surface + FILL_BYTES * fill
+    need = BASE + held + SURFACE_BYTES * surface + FILL_BYTES * fill
     if need > budget:
         raise Rend3rError(f"{what}: about {surface + fill:,} voxels need an estimated {need / 2**30:.2f} GiB at peak, "
                           f"over the memory budget of {budget / 2**30:.1f} GiB (--max-memory; "

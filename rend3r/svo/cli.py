@@ -129,10 +129,10 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
     """
     import numpy as np
 
-    from .budget import FILL_BYTES, check_budget, default_budget, max_voxels
+    from .budget import check_budget, default_budget
     from .fileformat import SvoModel, encode_svo
-    from .mesh_io import encode_binvox, read_binvox, read_mesh
-    from .octree import build_octree_codes, morton_decode, morton_encode, sorted_unique
+    from .mesh_io import encode_binvox, read_binvox_codes, read_mesh
+    from .octree import build_octree_codes, morton_decode
     from .voxelize import voxelize_codes
 
     budget = max_memory or default_budget()
@@ -143,21 +143,21 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
             if path:
                 out.reserve(path)
         if Path(mesh).suffix.lower() == ".binvox":
-            coords, dim, translate, scale = read_binvox(mesh, max_voxels(budget, FILL_BYTES))
-            need = max(int(np.ceil(np.log2(dim))), 1)
+            if solid:
+                raise Rend3rError("--solid applies to meshes; binvox voxels are used as stored")
+            codes, dim, translate, scale = read_binvox_codes(
+                mesh, lambda voxels, held: check_budget((voxels, 0), budget, mesh, held))
+            if len(codes) == 0:
+                raise Rend3rError(f"{mesh}: the binvox grid holds no solid voxel")
+            need = max((dim - 1).bit_length(), 1)
             if depth is not None and depth != need:
                 raise Rend3rError(f"{mesh}: a {dim}^3 binvox grid needs --depth {need}")
             depth = need
             h = scale / dim
             lo = np.asarray(translate, dtype=np.float64)
-            if solid:
-                raise Rend3rError("--solid applies to meshes; binvox voxels are used as stored")
             if not (np.all(np.isfinite(lo)) and np.isfinite(h) and h > 0
                     and np.all(np.isfinite(lo + h * (1 << depth)))):
                 raise Rend3rError(f"{mesh}: binvox translate and scale must be finite, scale positive")
-            check_budget((0, len(coords)), budget, mesh)
-            codes = sorted_unique(morton_encode(coords, depth))
-            del coords
         else:
             if depth is None:
                 raise Rend3rError(f"{mesh}: --depth is required for mesh input (e.g. --depth 8: 256 "

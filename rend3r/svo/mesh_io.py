@@ -12,13 +12,15 @@ from __future__ import annotations
 
 import os
 import struct
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import Rend3rError
 from ..fileio import read_limited, write_atomic
-from .octree import sorted_unique
+from .octree import morton_decode, morton_encode, sorted_unique
+from .voxelize import batches, expand_counts
 
 Mesh = tuple[np.ndarray, np.ndarray]
 MAX_MESH = 64 << 20
@@ -304,55 +306,116 @@ def encode_binvox(coords: np.ndarray, dim: int, translate=(0.0, 0.0, 0.0), scale
     return header + np.stack([v, counts], 1).astype(np.uint8).tobytes()
 
 
-def decode_binvox(data: bytes, name: str = "<binvox>", max_voxels: int | None = None,
-                  ) -> tuple[np.ndarray, int, np.ndarray, float]:
-    """Sparse voxels of a binvox file: (coords (k, 3), dim, translate, scale).
+_RUN_BLOCK = 1 << 16
+"""Run pairs read per pass of the binvox decoder (its temporaries are a few per run)."""
+_VOXEL_BATCH = 1 << 19
+"""Voxels expanded at once from runs (a run stands for at most 255)."""
+MAX_BINVOX_DIM = 1 << 16
+"""Largest binvox grid side: the octree depth ``svo build --depth`` accepts (16)."""
 
-    With ``max_voxels`` a file holding more solid voxels is refused before they are made
-    (a few bytes of runs can stand for billions of voxels).
-    """
+
+def _binvox_header(data: bytes, name: str) -> tuple[int, int, np.ndarray, float]:
+    """(offset of the run data, dim, translate, scale) of a binvox file's text header."""
     pos = data.find(b"data\n")
     if not data.startswith(b"#binvox") or pos < 0:
         raise Rend3rError(f"{name}: not a binvox file")
-    dims, translate, scale = None, np.zeros(3), 1.0
-    for line in data[:pos].decode("ascii", "replace").splitlines()[1:]:
+    dim, translate, scale = None, np.zeros(3), 1.0
+    at = 0
+    for line in data[:pos].decode("ascii", "replace").split("\n")[1:]:
+        at = data.index(b"\n", at) + 1
         p = line.split()
-        if p and p[0] == "dim":
-            dims = [int(x) for x in p[1:4]]
-        elif p and p[0] == "translate":
-            translate = np.array([float(x) for x in p[1:4]])
-        elif p and p[0] == "scale":
-            scale = float(p[1])
-    if dims is None or len(set(dims)) != 1 or dims[0] <= 0:
+        try:
+            if p and p[0] == "dim":
+                dims = [int(x) if x.isdigit() and len(x) <= 6 else 0 for x in p[1:]]
+                if len(dims) != 3 or len(set(dims)) != 1 or not 1 <= dims[0] <= MAX_BINVOX_DIM:
+                    raise ValueError(f"needs a cubic 'dim' of 1..{MAX_BINVOX_DIM} (got {line[:60]!r})")
+                dim = dims[0]
+            elif p and p[0] == "translate":
+                translate = np.array([float(x) for x in p[1:4]])
+            elif p and p[0] == "scale":
+                scale = float(p[1])
+        except (ValueError, IndexError) as exc:
+            raise Rend3rError(f"{name}: byte {at}: malformed binvox header line: {str(exc)[:100]}") from None
+    if dim is None:
         raise Rend3rError(f"{name}: binvox needs a cubic 'dim'")
-    dim = dims[0]
-    rle = np.frombuffer(data, np.uint8, offset=pos + 5)
+    return pos + 5, dim, translate, scale
+
+
+def _run_pairs(data: bytes, start: int, dim: int, name: str) -> tuple[np.ndarray, np.ndarray, int]:
+    """(values, counts) views of the run pairs and the number of solid voxels.
+
+    The runs are checked in blocks before any voxel is made: they must cover the
+    ``dim**3`` grid exactly; an error names the byte offset of the run at fault.
+    """
+    rle = np.frombuffer(data, np.uint8, offset=start)
     if len(rle) % 2:
-        raise Rend3rError(f"{name}: truncated binvox data")
-    values, counts = rle[0::2], rle[1::2].astype(np.int64)
-    if counts.sum() != dim ** 3:
-        raise Rend3rError(f"{name}: binvox data holds {counts.sum()} voxels, expected {dim ** 3}")
-    starts = np.cumsum(counts) - counts
-    on = values != 0
-    solid = int(counts[on].sum())
-    if max_voxels is not None and solid > max_voxels:
-        raise Rend3rError(f"{name}: {solid:,} solid voxels, over the {max_voxels:,} the memory budget "
-                          "allows (--max-memory)")
-    run = np.repeat(np.flatnonzero(on), counts[on])
-    offs = np.arange(len(run)) - (np.cumsum(counts[on]) - counts[on]).repeat(counts[on])
-    idx = starts[run] + offs
-    x, rem = idx // (dim * dim), idx % (dim * dim)
-    coords = np.stack([x, rem % dim, rem // dim], 1)
-    return coords, dim, translate, scale
+        raise Rend3rError(f"{name}: byte {start + len(rle) - 1}: truncated binvox data (a run value "
+                          "without its count)")
+    values, counts = rle[0::2], rle[1::2]
+    total, solid, cells = 0, 0, dim ** 3
+    for a in range(0, len(counts), _RUN_BLOCK):
+        run = np.cumsum(counts[a:a + _RUN_BLOCK], dtype=np.int64) + total
+        if run[-1] > cells:
+            over = a + int(np.searchsorted(run, cells, side="right"))
+            raise Rend3rError(f"{name}: byte {start + 2 * over}: binvox runs overflow the {dim}^3 grid "
+                              f"({cells:,} voxels)")
+        total = int(run[-1])
+        solid += int(counts[a:a + _RUN_BLOCK].sum(where=values[a:a + _RUN_BLOCK] != 0, dtype=np.int64))
+    if total < cells:
+        raise Rend3rError(f"{name}: byte {len(data)}: truncated binvox data (runs end at voxel {total:,} "
+                          f"of {cells:,})")
+    return values, counts, solid
 
 
-def read_binvox(path: str | os.PathLike[str], max_voxels: int | None = None):
-    """Sparse voxels of a binvox file (at most :data:`MAX_MESH` bytes; see :func:`decode_binvox`)."""
+def decode_binvox_codes(data: bytes, name: str = "<binvox>", budget: Callable[[int], None] | None = None,
+                        ) -> tuple[np.ndarray, int, np.ndarray, float]:
+    """A binvox file's voxels as sorted Morton codes: (codes, dim, translate, scale).
+
+    The grid's depth is the smallest with ``2**depth >= dim``. The runs are checked
+    first (:func:`_run_pairs`); ``budget(solid voxels)`` may then refuse the file
+    before the codes (8 bytes a voxel, the only array as long as the voxels) are made,
+    a batch of runs at a time.
+    """
+    start, dim, translate, scale = _binvox_header(data, name)
+    values, counts, solid = _run_pairs(data, start, dim, name)
+    if budget is not None:
+        budget(solid)
+    depth = max((dim - 1).bit_length(), 1)
+    codes = np.empty(solid, dtype=np.int64)
+    held, first = 0, 0
+    for a in range(0, len(counts), _RUN_BLOCK):
+        size = counts[a:a + _RUN_BLOCK].astype(np.int64)
+        on = values[a:a + _RUN_BLOCK] != 0
+        run_start, size = (np.cumsum(size) - size + first)[on], size[on]
+        first += int(counts[a:a + _RUN_BLOCK].sum(dtype=np.int64))
+        for part in batches(size, _VOXEL_BATCH):
+            run, k = expand_counts(size[part])
+            idx = run_start[part][run] + k
+            x, rem = np.divmod(idx, dim * dim)
+            batch = morton_encode(np.stack([x, rem % dim, rem // dim], 1), depth)
+            codes[held:held + len(batch)] = batch
+            held += len(batch)
+    codes.sort()
+    return codes, dim, translate, scale
+
+
+def decode_binvox(data: bytes, name: str = "<binvox>") -> tuple[np.ndarray, int, np.ndarray, float]:
+    """A binvox file's voxels as coordinates (k, 3) in Morton order: (coords, dim, translate, scale)."""
+    codes, dim, translate, scale = decode_binvox_codes(data, name)
+    return morton_decode(codes, max((dim - 1).bit_length(), 1)), dim, translate, scale
+
+
+def read_binvox_codes(path: str | os.PathLike[str], budget: Callable[[int, int], None] | None = None):
+    """:func:`decode_binvox_codes` of a file of at most :data:`MAX_MESH` bytes; ``budget``
+    is called with (solid voxels, the file's size)."""
     data = read_limited(path, MAX_MESH, what="binvox file")
-    try:
-        return decode_binvox(data, str(path), max_voxels)
-    except (IndexError, ValueError, OverflowError) as exc:
-        raise Rend3rError(f"{path}: malformed binvox file: {exc}") from None
+    check = None if budget is None else (lambda solid: budget(solid, len(data)))
+    return decode_binvox_codes(data, str(path), check)
+
+
+def read_binvox(path: str | os.PathLike[str]):
+    """:func:`decode_binvox` of a file of at most :data:`MAX_MESH` bytes."""
+    return decode_binvox(read_limited(path, MAX_MESH, what="binvox file"), str(path))
 
 
 def write_binvox(path: str | os.PathLike[str], coords: np.ndarray, dim: int,

@@ -49,7 +49,7 @@ def fit_bounds(verts: np.ndarray, depth: int) -> tuple[np.ndarray, float]:
     return lo, h
 
 
-def _expand(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def expand_counts(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For items with ``counts``: (item index, position 0..count-1) of every expanded row."""
     item = np.repeat(np.arange(len(counts)), counts)
     starts = np.cumsum(counts) - counts
@@ -92,7 +92,7 @@ def _surface_chunk(tri: np.ndarray, n: int) -> np.ndarray:
     hi = np.clip(np.floor(tri.max(1)).astype(np.int64), 0, n - 1)
     rows = np.arange(len(tri))
     nb, nc = hi[rows, b] - lo[rows, b] + 1, hi[rows, c] - lo[rows, c] + 1
-    t, pos = _expand(nb * nc)
+    t, pos = expand_counts(nb * nc)
     xb = lo[t, b[t]] + pos // nc[t]
     xc = lo[t, c[t]] + pos % nc[t]
     # range of the triangle's plane along the dominant axis over each column square
@@ -103,7 +103,7 @@ def _surface_chunk(tri: np.ndarray, n: int) -> np.ndarray:
     corners = [(d - nbv * (xb + i) - ncv * (xc + j)) / na for i in (0, 1) for j in (0, 1)]
     zlo = np.maximum(np.ceil(np.minimum.reduce(corners)).astype(np.int64) - 1, lo[t, at])
     zhi = np.minimum(np.floor(np.maximum.reduce(corners)).astype(np.int64), hi[t, at])
-    col, k = _expand(np.maximum(zhi - zlo + 1, 0))
+    col, k = expand_counts(np.maximum(zhi - zlo + 1, 0))
     coords = np.empty((len(col), 3), dtype=np.int64)
     rr = np.arange(len(col))
     coords[rr, at[col]] = zlo[col] + k
@@ -113,7 +113,7 @@ def _surface_chunk(tri: np.ndarray, n: int) -> np.ndarray:
     return coords[hit]
 
 
-def _batches(weights: np.ndarray, limit: int):
+def batches(weights: np.ndarray, limit: int):
     """Slices of consecutive items whose summed weight stays near ``limit``."""
     start = 0
     cum = np.cumsum(weights)
@@ -184,7 +184,7 @@ def _surface_keys(tri_grid: np.ndarray, n: int, key, max_voxels: int | None,
     keys = np.empty(0, dtype=np.int64)
     held = 0
     with progress(int(weight.sum()), "voxelising") as bar:
-        for s in _batches(weight, _CHUNK):
+        for s in batches(weight, _CHUNK):
             batch = sorted_unique(key(_surface_chunk(tri_grid[s], n)))
             bar.advance(int(weight[s].sum()))
             if held + len(batch) > len(keys):
@@ -225,7 +225,7 @@ def fill_solid(tri_grid: np.ndarray, n: int, max_voxels: int | None = None) -> n
     p = tri_grid[:, :, :2]
     lo = np.clip(np.floor(p.min(1) - 0.5).astype(np.int64), 0, n - 1)
     hi = np.clip(np.ceil(p.max(1) - 0.5).astype(np.int64), 0, n - 1)
-    t, pos = _expand((hi[:, 0] - lo[:, 0] + 1) * (hi[:, 1] - lo[:, 1] + 1))
+    t, pos = expand_counts((hi[:, 0] - lo[:, 0] + 1) * (hi[:, 1] - lo[:, 1] + 1))
     ny = hi[t, 1] - lo[t, 1] + 1
     ix, iy = lo[t, 0] + pos // ny, lo[t, 1] + pos % ny
     # column centres, nudged off exact edges by an irrational offset far below voxel size
@@ -254,7 +254,7 @@ def fill_solid(tri_grid: np.ndarray, n: int, max_voxels: int | None = None) -> n
     if max_voxels is not None and int(runs.sum()) > max_voxels:
         raise Rend3rError(f"the solid fill holds {int(runs.sum()):,} voxels, over the {max_voxels:,} "
                           "the memory budget allows (--max-memory; use a smaller --depth)")
-    run, k = _expand(runs)
+    run, k = expand_counts(runs)
     c = col[span][run]
     return np.stack([c // n, c % n, k0[run] + k], 1)
 

@@ -263,7 +263,7 @@ class Pixel(Handler):
             x, y = integer(args, "x", 0, options.width - 1), integer(args, "y", 0, options.height - 1)
             return fr.history(good.words, options, number, x, y, one(args, "shapes", "auto") == "all")
 
-        self.finish(json.dumps(await self.run(history)))
+        self.finish(await self.run(history))
 
 
 class SvoImage(Handler):
@@ -316,7 +316,7 @@ def make_app(view: View) -> tornado.web.Application:
         (r"/api/svo/ray", SvoRay),
         (r"/api/live", LiveSocket),
     ], default_handler_class=NotFound, view=view, serve_traceback=False, compress_response=True,
-        websocket_max_message_size=4096)
+        websocket_max_message_size=4096, log_function=lambda handler: None)  # errors: Handler.log_exception
 
 
 def new_token() -> str:

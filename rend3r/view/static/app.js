@@ -121,8 +121,9 @@ async function refreshSvo() {
 
 function pick(ev) {
   const img = ev.currentTarget;
-  const x = Math.floor(ev.offsetX * img.naturalWidth / img.clientWidth);
-  const y = Math.floor(ev.offsetY * img.naturalHeight / img.clientHeight);
+  const r = img.getBoundingClientRect();  // the image's content box: inside its border
+  const x = Math.floor((ev.clientX - r.left - img.clientLeft) * img.naturalWidth / img.clientWidth);
+  const y = Math.floor((ev.clientY - r.top - img.clientTop) * img.naturalHeight / img.clientHeight);
   picked = [Math.min(Math.max(x, 0), img.naturalWidth - 1), Math.min(Math.max(y, 0), img.naturalHeight - 1)];
   showPixel().catch((e) => showError(e.message));
 }

@@ -92,6 +92,24 @@ def difference(work: np.ndarray, ref: np.ndarray) -> tuple[np.ndarray, dict]:
                   "pixels": int(d.size)}
 
 
+class TraceCache:
+    """The last few pixel traces per (program version, options, frame, pixel): changing the
+    working precision at one pixel traces fp64 once."""
+
+    def __init__(self, size: int = 8) -> None:
+        self.size = size
+        self._traces: OrderedDict[tuple, list[dict]] = OrderedDict()
+
+    def trace(self, version: int, words: Sequence[int], options, frame: int, x: int, y: int) -> list[dict]:
+        key = (version, options, frame, x, y)
+        if key not in self._traces:
+            self._traces[key] = trace(words, options, frame, x, y)
+            while len(self._traces) > self.size:
+                self._traces.popitem(last=False)
+        self._traces.move_to_end(key)
+        return self._traces[key]
+
+
 def trace(words: Sequence[int], options, frame: int, x: int, y: int) -> list[dict]:
     """The records ``rend3r emulate --trace-pixel X,Y`` prints for frame ``frame``."""
     from ..emu.processor import execute
@@ -124,8 +142,12 @@ def _agreement(ar, work: list[dict], ref: list[dict]) -> list[tuple[dict | None,
     """Each working record's fp64 record (matched by shape, stage and occurrence, as
     ``rend3r trace-diff`` matches) and whether the two agree: integers and flags equal,
     values equal to the fp64 value rounded to the working format (NaN agrees with NaN)."""
-    by_key = dict(zip(_occurrences(ref), ref))
-    pairs = [by_key.get(key) for key in _occurrences(work)]
+    keys = [(r["shape"], r["stage"]) for r in work]
+    if keys == [(r["shape"], r["stage"]) for r in ref]:  # the same path: records pair in order
+        pairs: list[dict | None] = list(ref)
+    else:
+        by_key = dict(zip(_occurrences(ref), ref))
+        pairs = [by_key.get(key) for key in _occurrences(work)]
     agree = [f is not None and (not isinstance(r["dec"], int) or r["dec"] == f["dec"]) for r, f in zip(work, pairs)]
     values = [i for i, (r, f) in enumerate(zip(work, pairs)) if f is not None and not isinstance(r["dec"], int)]
     if values:
@@ -136,29 +158,37 @@ def _agreement(ar, work: list[dict], ref: list[dict]) -> list[tuple[dict | None,
     return list(zip(pairs, agree))
 
 
-def history(words: Sequence[int], options, frame: int, x: int, y: int, all_shapes: bool) -> dict:
+def _row(record: dict, ref: dict | None, agrees: bool) -> dict:
+    """A trace record with its fp64 value beside it."""
+    return {**record, "fp64": None if ref is None else {"hex": ref["hex"], "dec": ref["dec"]}, "diverges": not agrees}
+
+
+def history(words: Sequence[int], options, frame: int, x: int, y: int, all_shapes: bool,
+            traces: TraceCache | None = None, version: int = 0) -> dict:
     """A pixel's trace records, each with its fp64 record beside it and whether the two
     disagree; the first disagreeing value and the first disagreeing decision (an integer
-    or flag: hit, nearest, shadow, colour) are marked."""
+    or flag: hit, nearest, shadow, colour) are marked. ``traces`` keeps traces between
+    calls (for the program's ``version``)."""
     if not (0 <= x < options.width and 0 <= y < options.height):
         raise RequestError(f"pixel {x},{y} is outside the {options.width}x{options.height} frame")
-    work = trace(words, options, frame, x, y)
-    ref = trace(words, reference(options), frame, x, y)
+    traces = traces or TraceCache()
+    work = traces.trace(version, words, options, frame, x, y)
+    ref = traces.trace(version, words, reference(options), frame, x, y)
     ar = options.arith
-    rows = [{**r, "fp64": None if f is None else {"hex": f["hex"], "dec": f["dec"]}, "diverges": not ok}
-            for r, (f, ok) in zip(work, _agreement(ar, work, ref))]
-    first = next((i for i, r in enumerate(rows) if r["diverges"]), None)
-    decision = next((i for i, r in enumerate(rows) if r["diverges"] and isinstance(r["dec"], int)), None)
-    split = next((i for i, r in enumerate(rows) if r["stage"] == "nearest"), len(rows))
-    shapes = {r["shape"] for r in rows[:split]}
+    agreement = _agreement(ar, work, ref)
+    first = next((i for i, (_, ok) in enumerate(agreement) if not ok), None)
+    decision = next((i for i, (_, ok) in enumerate(agreement) if not ok and isinstance(work[i]["dec"], int)), None)
+    split = next((i for i, r in enumerate(work) if r["stage"] == "nearest"), len(work))
+    shapes = {r["shape"] for r in work[:split]}
     keep = shapes
     if len(shapes) > ALL_SHAPES_UP_TO and not all_shapes:
-        marked = [rows[i]["shape"] for i in (first, decision) if i is not None and i < split]
         keep = {r["shape"] for r in work + ref if r["stage"] == "hit" and r["dec"] == 1}
-        keep |= {r["dec"] for r in work + ref if r["stage"] == "nearest"} | set(marked)
-    shown = [r for r in rows[:split] if r["shape"] in keep] + rows[split:]
-    index = {id(r): i for i, r in enumerate(shown)}
+        keep |= {r["dec"] for r in work + ref if r["stage"] == "nearest"}
+        keep |= {work[i]["shape"] for i in (first, decision) if i is not None and i < split}
+    shown = [i for i in range(len(work)) if i >= split or work[i]["shape"] in keep]
+    index = {i: n for n, i in enumerate(shown)}
+    records = [_row(work[i], *agreement[i]) for i in shown]
     return {"frame": frame, "pixel": [x, y], "precision": options.precision, "label": ar.label,
-            "mode": options.mode, "shapes": len(shapes), "shapes_shown": len(keep & shapes), "records": shown,
-            "first_divergence": None if first is None else index[id(rows[first])],
-            "first_decision": None if decision is None else index[id(rows[decision])]}
+            "mode": options.mode, "shapes": len(shapes), "shapes_shown": len(keep & shapes), "records": records,
+            "first_divergence": None if first is None else index[first],
+            "first_decision": None if decision is None else index[decision]}

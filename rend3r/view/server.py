@@ -69,6 +69,7 @@ class View:
         self.token, self.hosts = token, hosts
         self.files = static_files()
         self.frames = fr.FrameCache()
+        self.traces = fr.TraceCache()
         self.svo_cache: tuple[tuple, object] | None = None
         self.work = ThreadPoolExecutor(1, thread_name_prefix="rend3r-view")
         self.watch = ThreadPoolExecutor(1, thread_name_prefix="rend3r-watch")
@@ -261,7 +262,8 @@ class Pixel(Handler):
             good, options = _options(self.view, args)
             number = _frame_number(args, fr.frame_count(good.words, options))
             x, y = integer(args, "x", 0, options.width - 1), integer(args, "y", 0, options.height - 1)
-            return fr.history(good.words, options, number, x, y, one(args, "shapes", "auto") == "all")
+            return fr.history(good.words, options, number, x, y, one(args, "shapes", "auto") == "all",
+                              self.view.traces, self.view.source.state.version)
 
         self.finish(await self.run(history))
 

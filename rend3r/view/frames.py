@@ -158,6 +158,26 @@ def _agreement(ar, work: list[dict], ref: list[dict]) -> list[tuple[dict | None,
     return list(zip(pairs, agree))
 
 
+#: How the shape shown is chosen: raytracing, then each raster visibility rule
+#: (docs/emulator.md, docs/raster.md).
+TIE_RULES = {"raytrace": "the smallest sq_dist wins; equal distances go to the lower shape index (docs/emulator.md)",
+             "zbuffer": "the depth buffer keeps the earlier triangle on equal depth (docs/raster.md)",
+             "painter": "painter's order by centroid distance, far to near; equal distances keep index order (docs/raster.md)",
+             "index": "no depth order: later triangles paint over earlier ones (quirk raster-index-order)"}
+
+
+def _hits(work: list[dict], ref: list[dict]) -> list[dict]:
+    """The shapes a raytraced pixel's ray hit, nearest first (ties in index order), with
+    their squared distances in both runs."""
+    def distances(records: list[dict]) -> dict[int, object]:
+        hit = {r["shape"] for r in records if r["stage"] == "hit" and r["dec"] == 1}
+        return {r["shape"]: r["dec"] for r in records if r["stage"] == "sq_dist" and r["shape"] in hit}
+
+    mine, theirs = distances(work), distances(ref)
+    order = sorted(mine, key=lambda shape: (float(mine[shape]), shape))
+    return [{"shape": shape, "sq_dist": mine[shape], "fp64_sq_dist": theirs.get(shape)} for shape in order]
+
+
 def _row(record: dict, ref: dict | None, agrees: bool) -> dict:
     """A trace record with its fp64 value beside it."""
     return {**record, "fp64": None if ref is None else {"hex": ref["hex"], "dec": ref["dec"]}, "diverges": not agrees}
@@ -167,7 +187,8 @@ def history(words: Sequence[int], options, frame: int, x: int, y: int, all_shape
             traces: TraceCache | None = None, version: int = 0) -> dict:
     """A pixel's trace records, each with its fp64 record beside it and whether the two
     disagree; the first disagreeing value and the first disagreeing decision (an integer
-    or flag: hit, nearest, shadow, colour) are marked. ``traces`` keeps traces between
+    or flag: hit, nearest, shadow, colour) are marked; a raytraced pixel's hits are listed
+    nearest first. ``traces`` keeps traces between
     calls (for the program's ``version``)."""
     if not (0 <= x < options.width and 0 <= y < options.height):
         raise RequestError(f"pixel {x},{y} is outside the {options.width}x{options.height} frame")
@@ -191,4 +212,5 @@ def history(words: Sequence[int], options, frame: int, x: int, y: int, all_shape
     return {"frame": frame, "pixel": [x, y], "precision": options.precision, "label": ar.label,
             "mode": options.mode, "shapes": len(shapes), "shapes_shown": len(keep & shapes), "records": records,
             "first_divergence": None if first is None else index[first],
-            "first_decision": None if decision is None else index[decision]}
+            "first_decision": None if decision is None else index[decision],
+            "hits": _hits(work, ref) if options.mode == "raytrace" else None, "tie_rule": TIE_RULES["raytrace" if options.mode == "raytrace" else options.depth]}

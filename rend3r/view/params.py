@@ -96,7 +96,7 @@ def size(args: Args, default: str) -> tuple[int, int]:
 
 def emu_options(args: Args, mode: str):
     """The :class:`rend3r.emu.options.EmuOptions` a request names: ``precision``,
-    ``subnormals``, ``profile``, ``quirk`` (repeatable) and ``size``, checked as
+    ``subnormals``, ``depth``, ``profile``, ``quirk`` (repeatable) and ``size``, checked as
     ``rend3r emulate`` checks its options."""
     from ..emu.arith import precision_name
     from ..emu.options import EmuOptions
@@ -109,6 +109,9 @@ def emu_options(args: Args, mode: str):
     subnormals = one(args, "subnormals")
     if subnormals not in (None, "ftz", "ieee"):
         raise RequestError(f"subnormals: ftz or ieee, not {subnormals!r}")
+    depth = one(args, "depth")
+    if depth not in (None, "zbuffer", "painter"):
+        raise RequestError(f"depth: zbuffer or painter, not {depth!r}")
     profile = one(args, "profile") or None
     quirks = values(args, "quirk")
     if len(quirks) > MAX_QUIRKS:
@@ -117,9 +120,10 @@ def emu_options(args: Args, mode: str):
         selected = quirk_names(profile, quirks)
     except Rend3rError as exc:
         raise RequestError(str(exc)) from None
-    if subnormals is not None:
-        for _, quirk, value in contradictions({"subnormals": subnormals}, selected):
-            raise RequestError(f"subnormals {subnormals} contradicts quirk {quirk}, which sets {value}")
+    given = {k: v for k, v in (("subnormals", subnormals), ("depth", depth)) if v is not None}
+    for field, quirk, value in contradictions(given, selected):
+        raise RequestError(f"{field} {given[field]} contradicts quirk {quirk}, which sets {value}")
     w, h = size(args, "512x384")
-    options = EmuOptions(precision=precision, subnormals=subnormals or "ftz", mode=mode, width=w, height=h)
+    options = EmuOptions(precision=precision, subnormals=subnormals or "ftz", mode=mode, width=w, height=h,
+                         depth=depth or "zbuffer")
     return apply_quirks(options, selected)

@@ -55,6 +55,10 @@ def test_pixel_history_is_the_trace_of_emulate_with_fp64_beside_it(tmp_path, que
     first = h["first_divergence"]
     assert first is not None and h["records"][first]["diverges"]
     assert not any(r["diverges"] for r in h["records"][:first])
+    hit = [r["shape"] for r in want if r["stage"] == "hit" and r["dec"] == 1]
+    nearest = next(r["dec"] for r in want if r["stage"] == "nearest")
+    assert sorted(x["shape"] for x in h["hits"]) == hit and h["hits"][0]["shape"] == nearest
+    assert "lower shape index" in h["tie_rule"]
 
 
 def test_the_first_divergence_is_the_first_value_off_fp64_rounded(tmp_path):
@@ -90,10 +94,10 @@ def test_frames_are_emulates_and_the_difference_counts_the_pixels_that_differ(tm
 def test_raster_and_device_quirks_and_a_frame_outside_the_program(tmp_path):
     program = ROOT / "programs" / "tri_cube.asm"
     with serve(program) as s:
-        _, h = s.json("/api/pixel?x=256&y=192&quirk=raster-pixel-snap")
-        assert h["mode"] == "raster"
+        _, h = s.json("/api/pixel?x=256&y=192&quirk=raster-pixel-snap&depth=painter")
+        assert h["mode"] == "raster" and h["hits"] is None and "painter" in h["tie_rule"]
         assert [{k: r[k] for k in TRACE_FIELDS} for r in h["records"]] == _trace_cli(
-            program, tmp_path, "256,192", "--device-quirk", "raster-pixel-snap")
+            program, tmp_path, "256,192", "--device-quirk", "raster-pixel-snap", "--depth", "painter")
         status, err = s.json("/api/frame?frame=1")
         assert status == 400 and "frame 1 is outside 0..0" in err["error"]
 
@@ -234,6 +238,8 @@ def test_only_the_pages_own_files_and_the_program_are_served(tmp_path, sphere_pr
     ("/api/frame?subnormals=maybe", 400, "subnormals"),
     ("/api/frame?quirk=warp-drive", 400, "unknown device quirk"),
     ("/api/frame?profile=rend3r-2022&subnormals=ieee", 400, "contradicts quirk flush-subnormals"),
+    ("/api/frame?quirk=raster-index-order&depth=painter", 400, "contradicts quirk raster-index-order"),
+    ("/api/frame?depth=sideways", 400, "depth"),
     ("/api/frame?frame=-1", 400, "frame"),
     ("/api/frame?frame=99999999999", 400, "frame"),
     ("/api/frame?frame=1&frame=2", 400, "once"),

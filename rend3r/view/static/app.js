@@ -32,7 +32,7 @@ function showError(text) {
 
 function emuParams() {
   const quirks = [...document.querySelectorAll("#quirks input:checked")].map((e) => e.value);
-  return { precision: $("precision").value.trim(), subnormals: $("subnormals").value,
+  return { precision: $("precision").value.trim(), subnormals: $("subnormals").value, depth: $("depth").value,
            profile: $("profile").value, quirk: quirks, frame: $("frame").value };
 }
 
@@ -151,7 +151,7 @@ async function showPixel() {
   const first = h.first_divergence === null ? "none" : describe(h.records[h.first_divergence]);
   const decision = h.first_decision === null ? "none" : describe(h.records[h.first_decision]);
   $("pixel-summary").textContent = `${h.label} against fp64. Shapes: ${h.shapes} considered, ${h.shapes_shown} shown. ` +
-    `First divergence: ${first}. First different decision: ${decision}.`;
+    `First divergence: ${first}. First different decision: ${decision}. ` + hitsText(h);
   let inPixel = false;
   const rows = h.records.map((r, i) => {
     const tr = document.createElement("tr");
@@ -167,6 +167,14 @@ async function showPixel() {
     return tr;
   });
   table(["shape", "stage", "hex", "dec", "fp64 hex", "fp64 dec"], rows);
+}
+
+function hitsText(h) {
+  if (h.hits === null) return `Nearest: ${h.tie_rule}.`;
+  if (!h.hits.length) return "No shape hit.";
+  const shown = h.hits.slice(0, 12).map((x) => `${x.shape} (sq_dist ${x.sq_dist}, fp64 ${x.fp64_sq_dist ?? "no hit"})`);
+  const more = h.hits.length > 12 ? `, and ${h.hits.length - 12} more` : "";
+  return `Hits, nearest first: ${shown.join(", ")}${more}. Rule: ${h.tie_rule}.`;
 }
 
 function describe(r) {

@@ -23,6 +23,7 @@ from .budget import max_voxels as voxel_limit
 from .octree import morton_decode, morton_encode, sorted_unique
 
 _CHUNK = 1 << 19  # candidate (triangle, voxel) pairs per vectorised batch
+_SLAB = 1 << 16  # (x, y) columns per slab of the solid fill
 MAX_COORD = 1e150
 """Largest vertex coordinate and extent: products of two coordinates stay finite."""
 MIN_VOXEL = 1e-150
@@ -159,6 +160,37 @@ def _split_large(tri: np.ndarray, n: int) -> np.ndarray:
     return np.concatenate(done)
 
 
+class _KeyBuffer:
+    """One growing buffer of int64 keys, sorted and deduplicated in place: 8 bytes a key
+    and no second array of all of them (growing it in place maps more pages instead of
+    copying). Beyond ``limit`` keys it is deduplicated, and still beyond it refused."""
+
+    def __init__(self, limit: int | None) -> None:
+        self.keys = np.empty(0, dtype=np.int64)
+        self.held = 0
+        self.limit = limit
+
+    def add(self, batch: np.ndarray, what: str) -> None:
+        """Append ``batch``; a Rend3rError names ``what`` when the distinct keys pass the limit."""
+        if self.held + len(batch) > len(self.keys):
+            self.keys.resize(max(self.held + len(batch), len(self.keys) * 3 // 2), refcheck=False)
+        self.keys[self.held:self.held + len(batch)] = batch
+        self.held += len(batch)
+        if self.limit is not None and self.held > self.limit and self.dedupe() > self.limit:
+            raise Rend3rError(f"the {what} holds more than {self.limit:,} voxels, the most the memory "
+                              "budget allows (--max-memory; use a smaller --depth)")
+
+    def dedupe(self) -> int:
+        """Sort and deduplicate the keys held; their number."""
+        self.held = _dedupe(self.keys, self.held)
+        return self.held
+
+    def result(self) -> np.ndarray:
+        """The sorted distinct keys (the buffer itself, trimmed)."""
+        self.keys.resize(self.dedupe(), refcheck=False)
+        return self.keys
+
+
 def voxelize_surface(tri_grid: np.ndarray, n: int, max_voxels: int | None = None) -> np.ndarray:
     """Unique voxels (M, 3) overlapped by triangles given in grid units (voxel i = [i, i+1]).
 
@@ -166,39 +198,21 @@ def voxelize_surface(tri_grid: np.ndarray, n: int, max_voxels: int | None = None
     are skipped; M is 0 when every triangle is degenerate. With ``max_voxels``, more
     voxels than that are refused with a Rend3rError as soon as the batches hold them.
     """
-    return _rows(_surface_keys(tri_grid, n, lambda c: _keys(c, n), max_voxels), n)
+    keys = _KeyBuffer(max_voxels)
+    _surface_keys(tri_grid, n, lambda c: _keys(c, n), keys)
+    return _rows(keys.result(), n)
 
 
-def _surface_keys(tri_grid: np.ndarray, n: int, key, max_voxels: int | None,
-                  progress: ProgressFactory = hidden) -> np.ndarray:
-    """Sorted unique ``key(coords)`` of the voxels the triangles overlap, batch by batch
-    (``progress``'s bar counts candidate voxels).
-
-    Each batch's unique keys are appended to one growing buffer (8 bytes a key: growing
-    it in place maps more pages instead of copying), which is sorted and deduplicated in
-    place at the end: no second array of all the keys.
-    """
+def _surface_keys(tri_grid: np.ndarray, n: int, key, keys: _KeyBuffer, progress: ProgressFactory = hidden) -> None:
+    """Add ``key(coords)`` of the voxels the triangles overlap to ``keys``, batch by batch
+    (``progress``'s bar counts candidate voxels)."""
     tri_grid = tri_grid[np.any(np.cross(tri_grid[:, 1] - tri_grid[:, 0], tri_grid[:, 2] - tri_grid[:, 0]), axis=1)]
     tri_grid = _split_large(tri_grid, n)
     weight = _weight(tri_grid, n)
-    keys = np.empty(0, dtype=np.int64)
-    held = 0
     with progress(int(weight.sum()), "voxelising") as bar:
         for s in batches(weight, _CHUNK):
-            batch = sorted_unique(key(_surface_chunk(tri_grid[s], n)))
+            keys.add(sorted_unique(key(_surface_chunk(tri_grid[s], n))), "surface")
             bar.advance(int(weight[s].sum()))
-            if held + len(batch) > len(keys):
-                keys.resize(max(held + len(batch), len(keys) * 3 // 2), refcheck=False)
-            keys[held:held + len(batch)] = batch
-            held += len(batch)
-            del batch
-            if max_voxels is not None and held > max_voxels:
-                held = _dedupe(keys, held)
-                if held > max_voxels:
-                    raise Rend3rError(f"the surface holds more than {max_voxels:,} voxels, the most the memory "
-                                      "budget allows (--max-memory; use a smaller --depth)")
-    keys.resize(_dedupe(keys, held), refcheck=False)
-    return keys
 
 
 def _dedupe(values: np.ndarray, count: int) -> int:
@@ -216,47 +230,83 @@ def _dedupe(values: np.ndarray, count: int) -> int:
     return kept
 
 
-def fill_solid(tri_grid: np.ndarray, n: int, max_voxels: int | None = None) -> np.ndarray:
-    """Voxels whose centre has a non-zero winding number (winding counted along +z).
+def _fill_keys(tri_grid: np.ndarray, n: int, key, keys: _KeyBuffer, progress: ProgressFactory = hidden) -> None:
+    """Add ``key(coords)`` of the voxels whose centre has a non-zero winding number
+    (counted along +z columns) to ``keys``.
 
-    With ``max_voxels`` the exact count is checked before the voxels are made, and a
-    larger fill is refused with a Rend3rError.
+    Slab by slab of about ``_SLAB`` columns along x: each slab's crossings are found in
+    batches of triangles and its spans expanded in batches of voxels, so memory holds one
+    slab's crossings and one batch, whatever the size of the fill (``progress``'s bar
+    counts columns of x).
     """
     p = tri_grid[:, :, :2]
     lo = np.clip(np.floor(p.min(1) - 0.5).astype(np.int64), 0, n - 1)
     hi = np.clip(np.ceil(p.max(1) - 0.5).astype(np.int64), 0, n - 1)
-    t, pos = expand_counts((hi[:, 0] - lo[:, 0] + 1) * (hi[:, 1] - lo[:, 1] + 1))
+    width = max(_SLAB // n, 1)
+    with progress(n, "filling") as bar:
+        for x0 in range(0, n, width):
+            x1 = min(x0 + width, n) - 1
+            here = (lo[:, 0] <= x1) & (hi[:, 0] >= x0)
+            slab_lo, slab_hi = lo[here], hi[here]
+            slab_lo[:, 0] = np.maximum(slab_lo[:, 0], x0)
+            slab_hi[:, 0] = np.minimum(slab_hi[:, 0], x1)
+            for coords in _spans(*_crossings(tri_grid[here], slab_lo, slab_hi, n), n):
+                keys.add(key(coords), "solid fill")
+            bar.advance(x1 - x0 + 1)
+
+
+def _crossings(tri: np.ndarray, lo: np.ndarray, hi: np.ndarray, n: int
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(column ix*n + iy, z, sign) where triangles cross the column centres of their
+    (x, y) boxes ``lo``..``hi``, sorted by column then z; sign -1 where the surface
+    faces up (an exit)."""
+    cols = (hi[:, 0] - lo[:, 0] + 1) * (hi[:, 1] - lo[:, 1] + 1)
+    parts = [_column_hits(tri[s], lo[s], hi[s], cols[s], n) for s in batches(cols, _CHUNK)]
+    if not parts:
+        return np.empty(0, np.int64), np.empty(0), np.empty(0, np.int64)
+    col, z, sign = (np.concatenate(x) for x in zip(*parts))
+    order = np.lexsort((z, col))
+    return col[order], z[order], sign[order]
+
+
+def _column_hits(tri: np.ndarray, lo: np.ndarray, hi: np.ndarray, cols: np.ndarray, n: int
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_crossings` of a batch of triangles, unsorted."""
+    t, pos = expand_counts(cols)
     ny = hi[t, 1] - lo[t, 1] + 1
     ix, iy = lo[t, 0] + pos // ny, lo[t, 1] + pos % ny
     # column centres, nudged off exact edges by an irrational offset far below voxel size
     qx, qy = ix + 0.5 + 1e-7 * np.sqrt(2), iy + 0.5 + 1e-7 * np.sqrt(3)
-    a, b, c = tri_grid[t, 0], tri_grid[t, 1], tri_grid[t, 2]
+    a, b, c = tri[t, 0], tri[t, 1], tri[t, 2]
+
     def edge(u, v):
         return (v[:, 0] - u[:, 0]) * (qy - u[:, 1]) - (v[:, 1] - u[:, 1]) * (qx - u[:, 0])
+
     w0, w1, w2 = edge(b, c), edge(c, a), edge(a, b)
     area = w0 + w1 + w2
     inside = (area != 0) & (((w0 > 0) & (w1 > 0) & (w2 > 0)) | ((w0 < 0) & (w1 < 0) & (w2 < 0)))
-    if not inside.any():  # no triangle covers a column centre seen from +z
-        return np.empty((0, 3), dtype=np.int64)
     z = (w0 * a[:, 2] + w1 * b[:, 2] + w2 * c[:, 2])[inside] / area[inside]
     sign = np.where(area[inside] > 0, -1, 1)  # counter-clockwise seen from +z faces up: an exit
-    col = (ix * n + iy)[inside]
-    order = np.lexsort((z, col))
-    col, z, sign = col[order], z[order], sign[order]
+    return (ix * n + iy)[inside], z, sign
+
+
+def _spans(col: np.ndarray, z: np.ndarray, sign: np.ndarray, n: int):
+    """Voxel coordinates (k, 3) between consecutive crossings of a column where the
+    winding number is not zero, in batches of about ``_CHUNK``."""
+    if not len(col):
+        return
     starts = np.flatnonzero(np.r_[True, col[1:] != col[:-1]])
     wind = np.cumsum(sign)
     wind -= np.repeat(wind[starts] - sign[starts], np.diff(np.r_[starts, len(col)]))
-    same_next = np.r_[col[1:] == col[:-1], False]
-    span = same_next & (wind != 0)
+    span = np.r_[col[1:] == col[:-1], False] & (wind != 0)
     k0 = np.clip(np.ceil(z[span] - 0.5).astype(np.int64), 0, n)
     k1 = np.clip(np.floor(z[np.flatnonzero(span) + 1] - 0.5).astype(np.int64), -1, n - 1)
     runs = np.maximum(k1 - k0 + 1, 0)
-    if max_voxels is not None and int(runs.sum()) > max_voxels:
-        raise Rend3rError(f"the solid fill holds {int(runs.sum()):,} voxels, over the {max_voxels:,} "
-                          "the memory budget allows (--max-memory; use a smaller --depth)")
-    run, k = expand_counts(runs)
-    c = col[span][run]
-    return np.stack([c // n, c % n, k0[run] + k], 1)
+    column = col[span]
+    for part in batches(runs, _CHUNK):
+        run, k = expand_counts(runs[part])
+        c = column[part][run]
+        yield np.stack([c // n, c % n, k0[part][run] + k], 1)
 
 
 def voxelize(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool = False,
@@ -276,9 +326,9 @@ def voxelize_codes(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool
 
     Codes (8 bytes a voxel) are what the octree builder sorts; coordinates are never held
     for the whole mesh. With ``budget`` (bytes) the build is refused up front when its
-    estimate (:mod:`rend3r.svo.budget`) exceeds it, and again on the exact counts of the
-    surface batches and the solid fill before they are expanded. ``progress(total, label)``
-    makes the bar of the surface batches.
+    estimate (:mod:`rend3r.svo.budget`) exceeds it, and again when the distinct codes the
+    surface and fill batches have made pass what the budget holds. ``progress(total,
+    label)`` makes the bars of the surface batches and of the fill's slabs.
     """
     faces = np.asarray(faces, dtype=np.int64)
     if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) == 0:
@@ -292,11 +342,13 @@ def voxelize_codes(verts: np.ndarray, faces: np.ndarray, depth: int, solid: bool
     if budget is not None:
         check_budget(estimate_voxels(tri, n, solid), budget, f"depth {depth}{' solid' if solid else ''}")
         limit = voxel_limit(budget)
-    codes = _surface_keys(tri, n, lambda c: morton_encode(c, depth), limit, progress)
-    if len(codes) == 0:
+    keys = _KeyBuffer(limit)
+    _surface_keys(tri, n, lambda c: morton_encode(c, depth), keys, progress)
+    surface = keys.dedupe()
+    if surface == 0:
         raise Rend3rError("mesh has no area: every triangle has equal or collinear vertices")
     if solid:
-        room = None if budget is None else voxel_limit(budget - SURFACE_BYTES * len(codes), FILL_BYTES)
-        fill = fill_solid(tri, n, room)
-        codes = sorted_unique(np.concatenate([codes, morton_encode(fill, depth)]))
-    return codes, lo, h
+        if budget is not None:
+            keys.limit = surface + voxel_limit(budget - SURFACE_BYTES * surface, FILL_BYTES)
+        _fill_keys(tri, n, lambda c: morton_encode(c, depth), keys, progress)
+    return keys.result(), lo, h

@@ -140,9 +140,7 @@ class Handler(tornado.web.RequestHandler):
 
     def write_error(self, status_code: int, **kwargs) -> None:
         exc = kwargs.get("exc_info", (None, None, None))[1]
-        if isinstance(exc, RequestError):
-            message = str(exc)
-        elif isinstance(exc, Rend3rError):
+        if isinstance(exc, (RequestError, Rend3rError)):
             message = str(exc)
         elif isinstance(exc, tornado.web.HTTPError):
             message = exc.log_message or self._reason

@@ -12,6 +12,7 @@ from __future__ import annotations
 import hashlib
 import os
 import threading
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,6 +21,9 @@ from ..errors import Rend3rError
 
 #: Source files of one folder looked at for changes (the rest of a huge folder is ignored).
 MAX_WATCHED_PER_DIR = 256
+#: A change is read once the files have stood still this long: an editor's save may
+#: truncate a file and then write it, and the half-way file is not the program.
+SETTLE_S = 0.05
 
 
 @dataclass(frozen=True)
@@ -86,6 +90,9 @@ class ProgramSource:
             signature = self.signature()
             if signature == self._signature:
                 return False
+            time.sleep(SETTLE_S)
+            if self.signature() != signature:
+                return False  # still being written: the next look reads it
             self._signature = signature
             before = (self.state.good, self.state.message)
             self._load()

@@ -256,6 +256,16 @@ def test_bad_requests_get_4xx_and_a_json_error(shared, query, status, words):
     assert shared.json("/api/status")[0] == 200  # and the server still serves
 
 
+def test_other_methods_get_405_and_a_json_error(shared):
+    import http.client
+
+    conn = http.client.HTTPConnection("127.0.0.1", shared.port, timeout=60)
+    conn.request("POST", "/api/status", body=b"x" * 1000, headers={"Host": f"127.0.0.1:{shared.port}"})
+    r = conn.getresponse()
+    assert r.status == 405 and json.loads(r.read())["status"] == 405
+    conn.close()
+
+
 @pytest.fixture(scope="module")
 def shared(tmp_path_factory):
     """One server for the table of bad requests."""

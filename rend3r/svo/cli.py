@@ -131,8 +131,8 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
 
     from .budget import check_budget, default_budget
     from .fileformat import SvoModel, encode_svo
-    from .mesh_io import encode_binvox, read_binvox_codes, read_mesh
-    from .octree import build_octree_codes, morton_decode
+    from .mesh_io import encode_binvox_codes, read_binvox_codes, read_mesh
+    from .octree import build_octree_codes
     from .voxelize import voxelize_codes
 
     budget = max_memory or default_budget()
@@ -169,10 +169,9 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
                 raise Rend3rError(f"{mesh}: {exc}") from None
             del verts, faces
         count = len(codes)
-        # the binvox bytes first: the coordinates they need are freed before the octree is built
+        # the binvox bytes first: written and freed before the octree's levels are held
         if binvox_out:
-            out.write(binvox_out, encode_binvox(morton_decode(codes, depth), 1 << depth, tuple(lo),
-                                                h * (1 << depth)))
+            out.write(binvox_out, encode_binvox_codes(codes, depth, tuple(lo), h * (1 << depth)))
         tree = build_octree_codes(codes, depth, ptr_bits, bars)
         del codes
         hi = lo + h * (1 << depth)

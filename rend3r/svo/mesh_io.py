@@ -279,31 +279,65 @@ def _binvox_index(coords: np.ndarray, dim: int) -> np.ndarray:
     return (coords[:, 0] * dim + coords[:, 2]) * dim + coords[:, 1]
 
 
+def _binvox_header_bytes(dim: int, translate, scale: float) -> bytes:
+    return (f"#binvox 1\ndim {dim} {dim} {dim}\ntranslate {translate[0]:.9g} {translate[1]:.9g} "
+            f"{translate[2]:.9g}\nscale {scale:.9g}\ndata\n").encode()
+
+
 def encode_binvox(coords: np.ndarray, dim: int, translate=(0.0, 0.0, 0.0), scale: float = 1.0) -> bytes:
     """binvox bytes for sparse voxels; runs are built from the sorted indices, never a dense grid."""
-    header = (f"#binvox 1\ndim {dim} {dim} {dim}\ntranslate {translate[0]:.9g} {translate[1]:.9g} "
-              f"{translate[2]:.9g}\nscale {scale:.9g}\ndata\n").encode()
     idx = sorted_unique(_binvox_index(np.asarray(coords, dtype=np.int64).reshape(-1, 3), dim))
-    total = dim ** 3
-    if len(idx):
-        brk = np.flatnonzero(np.diff(idx) != 1)
-        starts = np.r_[idx[0], idx[brk + 1]]
-        ends = np.r_[idx[brk] + 1, idx[-1] + 1]
-    else:
-        starts = ends = np.zeros(0, dtype=np.int64)
-    # alternate runs of 0 and 1: gap before each run of ones, then the ones, then the tail
-    gaps = starts - np.r_[0, ends[:-1]]
-    values = np.stack([np.zeros_like(starts), np.ones_like(starts)], 1).ravel()
-    lengths = np.stack([gaps, ends - starts], 1).ravel()
-    tail = total - (ends[-1] if len(ends) else 0)
-    values, lengths = np.r_[values, 0], np.r_[lengths, tail]
+    return _binvox_header_bytes(dim, translate, scale) + b"".join(_run_bytes(idx, dim ** 3))
+
+
+def encode_binvox_codes(codes: np.ndarray, depth: int, translate=(0.0, 0.0, 0.0), scale: float = 1.0) -> bytes:
+    """binvox bytes of a ``2**depth`` grid for distinct Morton codes: their binvox indices
+    (one 8-byte array, made in batches and sorted in place) and then runs, a block at a time."""
+    dim = 1 << depth
+    idx = np.empty(len(codes), dtype=np.int64)
+    for a in range(0, len(codes), _VOXEL_BATCH):
+        idx[a:a + _VOXEL_BATCH] = _binvox_index(morton_decode(codes[a:a + _VOXEL_BATCH], depth), dim)
+    idx.sort()
+    return _binvox_header_bytes(dim, translate, scale) + b"".join(_run_bytes(idx, dim ** 3))
+
+
+def _runs(idx: np.ndarray):
+    """(starts, ends) of the maximal runs of consecutive sorted distinct indices, block by block."""
+    pending = None
+    for a in range(0, len(idx), _VOXEL_BATCH):
+        block = idx[a:a + _VOXEL_BATCH]
+        brk = np.flatnonzero(np.diff(block) != 1)
+        starts, ends = np.r_[block[0], block[brk + 1]], np.r_[block[brk] + 1, block[-1] + 1]
+        if pending is not None and pending[1] == starts[0]:
+            starts[0] = pending[0]  # the run goes on across the blocks
+        elif pending is not None:
+            yield pending[:1], pending[1:]
+        pending = np.r_[starts[-1], ends[-1]]
+        yield starts[:-1], ends[:-1]
+    if pending is not None:
+        yield pending[:1], pending[1:]
+
+
+def _run_bytes(idx: np.ndarray, total: int):
+    """binvox run pairs (value, count <= 255) of a grid of ``total`` voxels with ``idx`` solid."""
+    done = 0
+    for starts, ends in _runs(idx):
+        # alternate runs of 0 and 1: the gap before each run of ones, then the ones
+        gaps = starts - np.r_[done, ends[:-1]]
+        yield _pairs(np.tile([0, 1], len(starts)), np.stack([gaps, ends - starts], 1).ravel())
+        done = int(ends[-1]) if len(ends) else done
+    yield _pairs(np.zeros(1, np.int64), np.array([total - done]))  # the empty tail
+
+
+def _pairs(values: np.ndarray, lengths: np.ndarray) -> bytes:
+    """Runs of ``values`` of any ``lengths`` (zero: none) as pairs of counts at most 255."""
     values, lengths = values[lengths > 0], lengths[lengths > 0]
     chunks = (lengths + 254) // 255
     v = np.repeat(values, chunks)
     first = np.cumsum(chunks) - chunks
     counts = np.full(int(chunks.sum()), 255, dtype=np.int64)
     counts[first + chunks - 1] = lengths - 255 * (chunks - 1)
-    return header + np.stack([v, counts], 1).astype(np.uint8).tobytes()
+    return np.stack([v, counts], 1).astype(np.uint8).tobytes()
 
 
 _RUN_BLOCK = 1 << 16

@@ -6,17 +6,24 @@ distributed cluster sized to the machine for the run, ``tcp://HOST:PORT`` uses a
 one (``dask scheduler`` and ``dask worker`` started as Dask documents), ``none`` runs the
 tasks one after another in this process, as does ``local`` when Dask is not installed
 (with a one-line note). Dask is imported only here and only when a cluster is used.
+The local cluster runs tasks on threads of this process by default, or in worker
+processes for tasks that hold the GIL (``processes=True``).
 
 A task that raises is reported by name (:class:`TaskFailed`, ``rend3r: error: TASK: ...``)
 and the other tasks are cancelled; the caller writes its outputs only after every map
 returned, so a failed run writes nothing. Ctrl-C cancels the tasks in flight and goes on as
-a KeyboardInterrupt (exit 130). A worker that dies has its tasks rerun by the scheduler on
-the others; the results do not depend on where a task ran.
+a KeyboardInterrupt (exit 130); local worker processes ignore Ctrl-C and are stopped at once
+by this process (a Ctrl-C while they start, a few seconds, is ignored too). A worker that
+dies has its tasks rerun by the scheduler on the others (and the results of earlier maps it
+held, :meth:`Campaign.map` ``keep=True``, recomputed); the results do not depend on where a
+task ran.
 """
 
 from __future__ import annotations
 
 import logging
+import os
+import signal
 from collections.abc import Callable, Sequence
 from types import TracebackType
 from typing import Any, TypeVar
@@ -67,15 +74,20 @@ def dask_installed() -> bool:
 class Campaign:
     """Where one run's tasks execute; a context manager that starts and stops the cluster.
 
-    The local cluster runs in this process: one worker with a thread per core (the
-    renderers' kernels release the GIL, and nothing is started or shipped between
-    processes). ``note`` receives the line printed when Dask is missing and the run falls
-    back to serial.
+    The local cluster runs ``workers`` tasks at once (default: one per core). By default
+    they are threads of one worker in this process: the renderers' kernels release the
+    GIL, and nothing is started or shipped between processes. With ``processes=True``,
+    for tasks that hold the GIL (pure-Python loops), each is a worker process with one
+    thread. ``note`` receives the line printed when Dask is missing and the run falls back
+    to serial.
     """
 
-    def __init__(self, scheduler: str = LOCAL, *,
+    def __init__(self, scheduler: str = LOCAL, *, workers: int | None = None, processes: bool = False,
                  note: Callable[[str], None] = lambda line: click.echo(line, err=True)) -> None:
+        if workers is not None and workers < 1:
+            raise ValueError("a local cluster needs at least one worker")
         self.scheduler = parse_scheduler(scheduler)
+        self.workers, self.processes = workers, processes
         self._note = note
         self._cluster: Any = None
         self._client: Any = None
@@ -96,11 +108,16 @@ class Campaign:
         from distributed import Client, LocalCluster
 
         from ..emu.threads import available_cores
+        from ..svo.interrupt import ctrl_c_ignored
 
         try:
             if self.scheduler == LOCAL:
-                self._cluster = LocalCluster(n_workers=1, threads_per_worker=available_cores(), processes=False,
-                                             dashboard_address=None, silence_logs=logging.CRITICAL)
+                slots = self.workers or available_cores()
+                shape = {"n_workers": slots, "threads_per_worker": 1} if self.processes else \
+                    {"n_workers": 1, "threads_per_worker": slots}
+                with ctrl_c_ignored():  # worker processes inherit it: a Ctrl-C stops the run here, which stops them
+                    self._cluster = LocalCluster(**shape, processes=self.processes, dashboard_address=None,
+                                                 silence_logs=logging.CRITICAL)
                 self._client = Client(self._cluster)
             else:
                 self._client = Client(self.scheduler, timeout=CONNECT_TIMEOUT)
@@ -111,7 +128,17 @@ class Campaign:
 
     def __exit__(self, kind: type[BaseException] | None, value: BaseException | None,
                  tb: TracebackType | None) -> None:
+        if kind is not None and self._cluster is not None and self.processes:
+            self._stop_worker_processes()
         self._close()
+
+    def _stop_worker_processes(self) -> None:
+        """Kill the local worker processes, still busy with cancelled tasks, rather than wait
+        for them (a graceful close waits seconds for a task to end)."""
+        for nanny in self._cluster.workers.values():
+            nanny.close_gracefully()  # no restart when its worker dies
+            if nanny.process is not None and nanny.process.pid is not None:
+                os.kill(nanny.process.pid, signal.SIGKILL)
 
     def _close(self) -> None:
         if self._client is not None:
@@ -122,17 +149,20 @@ class Campaign:
             self._cluster = None
 
     def map(self, function: Callable[..., R], inputs: Sequence[tuple], names: Sequence[str],
-            progress: Progress) -> list[R]:
+            progress: Progress, *, keep: bool = False) -> list[R]:
         """``[function(*args) for args in inputs]``, advancing ``progress`` one unit per task.
 
         ``names[i]`` names task ``i`` in a failure. ``function`` must be importable by the
         workers (a module-level function or a partial of one) and return picklable values.
+        With ``keep`` the results stay on the workers that computed them: what comes back
+        are handles (the results themselves when serial) to pass as arguments of a later
+        map's tasks, which receive the results; a handle lost with its worker is recomputed.
         """
         if len(names) != len(inputs):
             raise ValueError("one name per task input")
         if self._client is None:
             return [self._serial(function, args, name, progress) for args, name in zip(inputs, names)]
-        return self._distributed(function, inputs, names, progress)
+        return self._distributed(function, inputs, names, progress, keep)
 
     @staticmethod
     def _serial(function: Callable[..., R], args: tuple, name: str, progress: Progress) -> R:
@@ -144,7 +174,7 @@ class Campaign:
         return result
 
     def _distributed(self, function: Callable[..., R], inputs: Sequence[tuple], names: Sequence[str],
-                     progress: Progress) -> list[R]:
+                     progress: Progress, keep: bool) -> list[R]:
         from distributed import as_completed
 
         # pure=False: every task runs, even two with equal inputs; keys stay unique per run
@@ -158,7 +188,7 @@ class Campaign:
                     raise Rend3rError(f"{names[index[future.key]]}: cancelled: the Dask scheduler went away "
                                       "or gave up on it")
                 progress.advance(1)
-            return self._client.gather(futures)
+            return futures if keep else self._client.gather(futures)
         except BaseException:
             self._client.cancel(futures)
             raise

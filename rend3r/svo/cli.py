@@ -14,6 +14,7 @@ from pathlib import Path
 
 import click
 
+from ..campaign.options import SCHEDULER
 from ..cliutil import SIZE
 from ..errors import Rend3rError
 from ..fileio import Outputs
@@ -321,20 +322,26 @@ def _png(image) -> bytes:
 @click.option("--size", type=SIZE, default="320x240", show_default=True, help="Image size WxH (1..8192 each).")
 @click.option("--views", type=click.IntRange(1, 16), default=1, show_default=True, metavar="N",
               help="Camera azimuths averaged (the thesis used four for Table 7.1).")
-@click.option("--jobs", type=click.IntRange(1, 64), default=2, show_default=True, metavar="N",
-              help="Worker processes.")
+@click.option("--jobs", type=click.IntRange(0, 64), default=0, show_default=True, metavar="N",
+              help="Worker processes of the local cluster (--scheduler local); 0 uses one per core.")
+@SCHEDULER
 @_KERNEL
 @quiet_option
-def sweep_cmd(model: str, output: str, size, views: int, jobs: int, kernel: str, quiet: bool) -> None:
+def sweep_cmd(model: str, output: str, size, views: int, jobs: int, scheduler: str, kernel: str,
+              quiet: bool) -> None:
     """Simulate the design points of the thesis's Tables 7.1 and 8.2 on MODEL.svo.
 
-    Writes both tables (STEM.csv, STEM.md) or neither.
+    Writes both tables (STEM.csv, STEM.md) or neither. The stack depths are traced, and the
+    caches simulated, as independent tasks on --scheduler (docs/campaigns.md); the tables
+    do not depend on where they ran.
 
     \b
     Example:
       rend3r svo sweep out/folded.svo -o out/sweep
       rend3r svo sweep out/folded.svo -o out/sweep4 --views 4 --jobs 2
+      rend3r svo sweep out/folded.svo -o out/sweep --scheduler tcp://10.0.0.5:8786
     """
+    from ..campaign.runner import Campaign
     from .fileformat import read_svo
     from .sweep import run_sweep, thesis_points, to_csv, to_markdown
 
@@ -345,8 +352,9 @@ def sweep_cmd(model: str, output: str, size, views: int, jobs: int, kernel: str,
         kernel = _kernel(kernel, True)
         svo = read_svo(model)
         start = time.perf_counter()
-        rows = run_sweep(svo, thesis_points(), size[0], size[1], views, jobs, partial(Progress, quiet=quiet),
-                         kernel)
+        with Campaign(scheduler, workers=jobs or None, processes=True) as campaign:
+            rows = run_sweep(svo, thesis_points(), campaign, size[0], size[1], views,
+                             partial(Progress, quiet=quiet), kernel)
         header = (f"# SVO design sweep: {Path(model).name}, {size[0]}x{size[1]}, {views} view(s)\n\n"
                   "Frame times from the model in rend3r/svo/cores.py (50 MHz, 95 MB/s).\n\n")
         out.write(csv_path, to_csv(rows).encode())

@@ -17,7 +17,9 @@ Python runs its SIGINT handler in the main thread between bytecodes. Two things 
 
 Outputs are committed only at the end (:mod:`rend3r.fileio`); :func:`ctrl_c_ignored`
 covers that commit and the summary line, so a run either stops with nothing written or
-completes and exits 0 with everything written, never both.
+completes and exits 0 with everything written, never both. ``svo sweep`` runs its tasks as
+a campaign, whose local worker processes ignore Ctrl-C and are stopped by the command
+(:mod:`rend3r.campaign.runner`).
 """
 
 from __future__ import annotations
@@ -68,21 +70,3 @@ def ctrl_c_ignored() -> Iterator[None]:
         yield
     finally:
         signal.signal(signal.SIGINT, previous)
-
-
-@contextmanager
-def sigint_blocked() -> Iterator[None]:
-    """SIGINT held back (not lost) inside the block: processes forked there start with it
-    blocked, so they can ignore it before a Ctrl-C reaches them."""
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
-
-
-def ignore_sigint_in_worker() -> None:
-    """Pool initializer: the worker ignores Ctrl-C (the parent stops the pool), then lets
-    other signals through."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})

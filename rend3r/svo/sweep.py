@@ -1,27 +1,26 @@
 """Design-space sweeps like the thesis's Tables 7.1 (cache miss rates) and 8.2 (frame
-times), run in parallel processes.
+times), run as a campaign (:mod:`rend3r.campaign.runner`, ``docs/campaigns.md``).
 
-Each stack depth is traced once per view with its memory requests recorded; every
-(stack, cache) pair is then simulated in a worker process, and the frame-time model
-is evaluated for each core count and scheduling policy of that pair.
+Each stack depth is traced once in every view with its memory requests recorded (a task
+per stack, :func:`trace_stack`, whose traces stay on the worker); every (stack, cache) pair
+is then simulated (a task per pair, :func:`evaluate`, given its stack's traces), and the
+frame-time model is evaluated for each core count and scheduling policy of that pair.
 """
 
 from __future__ import annotations
 
 import csv
 import io
-import multiprocessing
-from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ..campaign.runner import Campaign
 from ..progress import ProgressFactory, hidden
 from .cache import CacheConfig, simulate
 from .camera import orbit_camera
 from .cores import Platform, compute_cycles, frame_time
 from .fileformat import SvoModel
-from .interrupt import ignore_sigint_in_worker, sigint_blocked
 from .render import render
 from .traverse import Kernel
 
@@ -66,15 +65,19 @@ def thesis_points() -> list[DesignPoint]:
                                       p.cores, p.policy))
 
 
-_TRACES: dict[int, list[dict[str, np.ndarray]]] = {}
+Trace = dict[str, np.ndarray]
+"""One view's per-ray compute cycles and requests, and its memory requests in ray order."""
+
+Job = tuple[int, int, int, int, "int | None", tuple[tuple[int, str], ...]]
+"""(stack, cache size, block, ways, max level, ((cores, policy), ...)): one simulation task."""
 
 
-def _trace_views(model: SvoModel, stack: int, views: int, width: int, height: int, kernel: Kernel,
-                 on_rays: Callable[[int], None] | None) -> list[dict[str, np.ndarray]]:
+def trace_stack(model: SvoModel, stack: int, views: int, width: int, height: int, kernel: Kernel) -> list[Trace]:
+    """Task: ``model`` traced with a ``stack``-deep short stack from each of ``views`` azimuths."""
     out = []
     for v in range(views):
         cam = orbit_camera(model.bounds, azimuth=35.0 + 360.0 * v / views, width=width, height=height)
-        res = render(model, cam, stack, True, "depth", record=True, kernel=kernel, on_rays=on_rays).result
+        res = render(model, cam, stack, True, "depth", record=True, kernel=kernel).result
         out.append({
             "compute": compute_cycles(res.steps, res.descents, res.pops, res.restarts, res.requests),
             "requests": res.requests, "ray": res.trace_ray, "addr": res.trace_addr,
@@ -83,12 +86,13 @@ def _trace_views(model: SvoModel, stack: int, views: int, width: int, height: in
     return out
 
 
-def _evaluate(job: tuple[int, int, int, int, int | None, tuple[tuple[int, str], ...]]) -> list[dict]:
-    """Worker: one (stack, cache) pair over all its (cores, policy) combinations."""
+def evaluate(job: Job, traces: list[Trace]) -> list[dict]:
+    """Task: one (stack, cache) pair over all its (cores, policy) combinations, on its
+    stack's ``traces``."""
     stack, size, block, ways, max_level, runs = job
     cfg = CacheConfig(size, block, ways, max_level)
     per_view = []
-    for tr in _TRACES[stack]:
+    for tr in traces:
         hits = simulate(tr["addr"], tr["level"], cfg)
         misses = np.bincount(tr["ray"][~hits], minlength=len(tr["compute"])).astype(np.float64)
         per_view.append((tr, hits, misses))
@@ -108,39 +112,29 @@ def _evaluate(job: tuple[int, int, int, int, int | None, tuple[tuple[int, str], 
     return rows
 
 
-def run_sweep(model: SvoModel, points: list[DesignPoint], width: int = 320, height: int = 240,
-              views: int = 1, jobs: int = 2, progress: ProgressFactory = hidden,
+def run_sweep(model: SvoModel, points: list[DesignPoint], campaign: Campaign, width: int = 320,
+              height: int = 240, views: int = 1, progress: ProgressFactory = hidden,
               kernel: Kernel = "auto") -> list[dict]:
-    """Evaluate ``points``; returns one row per point (see :data:`COLUMNS`).
+    """Evaluate ``points`` as tasks of ``campaign`` (entered); one row per point (see
+    :data:`COLUMNS`), the same wherever the tasks ran.
 
     ``kernel`` traces the frames (:func:`rend3r.svo.traverse.resolve_kernel`; the rows do
-    not depend on it).
-    ``progress(total, label)`` makes the bars of the two stages: tracing (rays) and
-    simulating the caches and cores (design points). Worker processes ignore Ctrl-C; the
-    KeyboardInterrupt it raises here ends them.
+    not depend on it). ``progress(total, label)`` makes the bars of the two stages, in
+    tasks: tracing (a stack depth each) and simulating (a (stack, cache) pair each).
     """
-    _TRACES.clear()
     stacks = sorted({p.stack for p in points})
-    with progress(len(stacks) * views * width * height, "tracing") as bar:
-        for stack in stacks:
-            _TRACES[stack] = _trace_views(model, stack, views, width, height, kernel, bar.advance)
+    with progress(len(stacks), "tracing") as bar:
+        traced = campaign.map(trace_stack, [(model, s, views, width, height, kernel) for s in stacks],
+                              [f"tracing stack {s}" for s in stacks], bar, keep=True)
+    traces = dict(zip(stacks, traced))
     groups: dict[tuple, list[tuple[int, str]]] = {}
     for p in points:
         groups.setdefault((p.stack, p.cache, p.block, p.ways, p.max_level), []).append((p.cores, p.policy))
-    tasks = [key + (tuple(runs),) for key, runs in groups.items()]
-    results = []
-    with progress(len(points), "simulating") as bar:
-        if jobs > 1 and len(tasks) > 1:
-            with sigint_blocked():  # workers start with Ctrl-C held back until they ignore it
-                pool = multiprocessing.get_context("fork").Pool(jobs, ignore_sigint_in_worker)
-            with pool:  # on leaving, even by Ctrl-C, the workers are terminated
-                for rows in pool.imap(_evaluate, tasks, chunksize=1):
-                    results.append(rows)
-                    bar.advance(len(rows))
-        else:
-            for task in tasks:
-                results.append(_evaluate(task))
-                bar.advance(len(results[-1]))
+    jobs = [key + (tuple(runs),) for key, runs in groups.items()]
+    names = [f"stack {j[0]}, cache {j[1]}x{j[2]} {j[3]}-way" + (f" to level {j[4]}" if j[4] is not None else "")
+             for j in jobs]
+    with progress(len(jobs), "simulating") as bar:
+        results = campaign.map(evaluate, [(j, traces[j[0]]) for j in jobs], names, bar)
     return [row for rows in results for row in rows]
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import operator
+import os
 import subprocess
 import sys
 import time
@@ -162,3 +163,45 @@ print(sorted(m for m in sys.modules if m.split(".")[0] in ("dask", "distributed"
 """
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False)
     assert (done.returncode, done.stdout) == (0, "[]\n"), done.stderr
+
+
+@pytest.mark.parametrize("scheduler, processes", [("none", False), pytest.param("local", False, marks=needs_dask),
+                                                  pytest.param("local", True, marks=needs_dask)])
+def test_kept_results_are_passed_to_a_later_map(scheduler, processes):
+    # functions the worker processes can import (this module is not on their path)
+    with Campaign(scheduler, workers=2, processes=processes) as campaign:
+        kept = campaign.map(pow, [(x, 2) for x in range(6)], [str(x) for x in range(6)], Counter(), keep=True)
+        assert (kept == [x * x for x in range(6)]) == (scheduler == "none")  # handles on a cluster
+        found = campaign.map(operator.add, [(k, 1) for k in kept], [str(x) for x in range(6)], Counter())
+    assert found == [x * x + 1 for x in range(6)]
+
+
+@needs_dask
+def test_local_worker_processes_one_thread_each():
+    with Campaign("local", workers=2, processes=True) as campaign:
+        workers = campaign._client.scheduler_info()["workers"].values()
+        assert sorted(w["nthreads"] for w in workers) == [1, 1]
+        pids = campaign.map(os.getpid, [()] * 4, ["pid"] * 4, Counter())
+    assert os.getpid() not in pids
+
+
+def test_a_local_cluster_needs_a_worker():
+    with pytest.raises(ValueError, match="at least one worker"):
+        Campaign("local", workers=0)
+
+
+@needs_dask
+def test_ctrl_c_stops_the_local_worker_processes_at_once():
+    def interrupt(done: int) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        with Campaign("local", workers=2, processes=True) as campaign:
+            pids = list(campaign._client.run(os.getpid).values())
+            campaign.map(time.sleep, [(0.0,)] + [(30.0,)] * 3, ["nap"] * 4, Counter(interrupt))
+            assert False, "not interrupted"
+    stopped = time.monotonic()
+    while any(os.path.exists(f"/proc/{pid}") and "zombie" not in open(f"/proc/{pid}/status").read()
+              for pid in pids) and time.monotonic() - stopped < 1:
+        time.sleep(0.05)
+    assert all(not os.path.exists(f"/proc/{pid}") or "zombie" in open(f"/proc/{pid}/status").read() for pid in pids)

@@ -1,5 +1,6 @@
 """Campaigns on an existing cluster: a real ``dask scheduler`` and two ``dask worker``
-processes on 127.0.0.1, one of them killed in the middle of a campaign."""
+processes on 127.0.0.1, one of them killed in the middle of a campaign (explore's renders,
+svo sweep's traces and simulations)."""
 
 from __future__ import annotations
 
@@ -109,6 +110,42 @@ def test_a_worker_killed_mid_campaign_has_its_tasks_rerun(cluster):
         found = campaign.map(task, inputs, names, bar)
     assert workers[0].returncode == -signal.SIGKILL and workers[1].poll() is None
     assert bar.done == len(inputs)
+    assert found == serial
+
+
+class KillOnceBars(KillOnce):
+    """:class:`KillOnce` as the progress factory of a sweep: its bars count on from one to the next."""
+
+    def __call__(self, total: int, label: str) -> KillOnceBars:
+        return self
+
+    def __enter__(self) -> KillOnceBars:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        pass
+
+
+def test_a_worker_killed_mid_sweep_has_its_tasks_and_traces_recomputed(cluster):
+    from rend3r.svo.fileformat import SvoModel
+    from rend3r.svo.models import make_model
+    from rend3r.svo.octree import build_octree_codes
+    from rend3r.svo.sweep import run_sweep, thesis_points
+    from rend3r.svo.voxelize import voxelize_codes
+
+    address, (_, *workers) = cluster
+    codes, lo, h = voxelize_codes(*make_model("torus", 24), 5, False, 1 << 30)
+    model = SvoModel(build_octree_codes(codes, 5), tuple(lo) + tuple(lo + 32 * h), len(codes))
+    points = thesis_points()
+    with Campaign("none") as campaign:
+        serial = run_sweep(model, points, campaign, 24, 18, views=2, kernel="numpy")
+
+    # 5 stack depths traced, then the third simulation back: the killed worker held traces
+    bars = KillOnceBars(workers[0], at=5 + 3)
+    with Campaign(address) as campaign:
+        found = run_sweep(model, points, campaign, 24, 18, views=2, progress=bars, kernel="numpy")
+    assert workers[0].returncode == -signal.SIGKILL and workers[1].poll() is None
+    assert bars.done == 5 + 76
     assert found == serial
 
 

@@ -2,8 +2,8 @@
 
 Each test starts the real CLI in its own process group with stderr on a pseudo-terminal
 (so the progress bar shows), waits for the bar of the stage it means to interrupt, and
-sends SIGINT to the whole group, as a terminal's Ctrl-C does (sweep's worker processes
-get it too).
+sends SIGINT to the whole group, as a terminal's Ctrl-C does (sweep's local worker
+processes get it too, ignore it, and are stopped by the command).
 """
 
 import os

@@ -8,7 +8,13 @@ and ``tradeoff.png`` (time against error, one point per mode and program, drawn 
 Pillow) into ``--out`` (default ``docs/``): the folder is made before any measuring, and
 the two files are written together or not at all.
 
-    python benchmarks/bench_tradeoff.py [--size 256x192] [--repeat 3] [--out DIR]
+Each program is measured by one task of a campaign (:mod:`rend3r.campaign.runner`,
+``docs/campaigns.md``) on ``--scheduler``: ``none`` (the default) measures one program at a
+time, so no other render shares the machine with the one being timed; ``local`` or
+``tcp://HOST:PORT`` measure programs side by side (quicker, the error figures the same,
+the times those of renders sharing their workers' machines).
+
+    python benchmarks/bench_tradeoff.py [--size 256x192] [--repeat 3] [--out DIR] [--scheduler none]
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rend3r.campaign.runner import Campaign, parse_scheduler
 from rend3r.cliutil import parse_size
 from rend3r.emu import EmuOptions, load_program, run_program
 from rend3r.errors import Rend3rError
@@ -31,6 +38,7 @@ from rend3r.fileio import make_output_folder, write_all
 from rend3r.golden.catalog import ExampleProgram, discover
 from rend3r.golden.metrics import image_metrics, provenance_metrics
 from rend3r.memory import reuse_freed_memory
+from rend3r.progress import Progress
 
 ROOT = Path(__file__).resolve().parents[1]
 MODES: dict[str, dict[str, str]] = {
@@ -62,15 +70,25 @@ def render(program: ExampleProgram, words: list[int], mode_hint: str | None, opt
     return run_program(words, options=replace(options, mode=mode), frames=program.frames).frames
 
 
-def measure(program: ExampleProgram, size: tuple[int, int], repeat: int) -> list[Row]:
-    loaded = load_program(program.path)
+def measure(program: ExampleProgram, words: list[int], mode_hint: str | None, size: tuple[int, int],
+            repeat: int) -> list[Row] | str:
+    """The campaign task: one loaded program in every mode; its rows, or why it was skipped
+    (a Rend3rError, e.g. a mode the emulator lacks, must not stop the other programs)."""
+    try:
+        return _measure(program, words, mode_hint, size, repeat)
+    except Rend3rError as exc:
+        return str(exc)
+
+
+def _measure(program: ExampleProgram, words: list[int], mode_hint: str | None, size: tuple[int, int],
+             repeat: int) -> list[Row]:
     base = EmuOptions(width=size[0], height=size[1])
     results: dict[str, tuple[float, list]] = {}
     for mode, fields in MODES.items():
         times, frames = [], []
         for _ in range(repeat):
             start = time.perf_counter()
-            frames = render(program, loaded.words, loaded.mode_hint, replace(base, **fields))
+            frames = render(program, words, mode_hint, replace(base, **fields))
             times.append((time.perf_counter() - start) / len(frames))
         results[mode] = (statistics.median(times), frames)
     ref = results["fp64"][1]
@@ -214,6 +232,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=3, help="runs per mode; the median is reported")
     ap.add_argument("--out", type=Path, default=ROOT / "docs", help="folder for tradeoff.md and tradeoff.png")
     ap.add_argument("--only", nargs="*", help="program names to measure (default: all)")
+    ap.add_argument("--scheduler", type=parse_scheduler, default="none",
+                    help="where the programs are measured: none (one at a time, the default), local, tcp://HOST:PORT")
     args = ap.parse_args(argv)
     size = parse_size(args.size)
     try:  # before any measuring: a folder that cannot be made fails now, not after minutes
@@ -221,13 +241,24 @@ def main(argv: list[str] | None = None) -> int:
     except Rend3rError as exc:
         print(f"rend3r: error: {exc}", file=sys.stderr)
         return 1
-    programs = [p for p in discover(args.programs) if not args.only or p.name in args.only]
-    rows: list[Row] = []
-    for program in programs:
-        try:
-            measured = measure(program, size, args.repeat)
-        except Rend3rError as exc:  # e.g. a mode the emulator lacks must not stop the others
+    inputs = []
+    for program in (p for p in discover(args.programs) if not args.only or p.name in args.only):
+        try:  # read here: a worker needs no files
+            loaded = load_program(program.path)
+        except Rend3rError as exc:
             print(f"{program.name}: skipped: {exc}", file=sys.stderr)
+            continue
+        inputs.append((program, loaded.words, loaded.mode_hint, size, args.repeat))
+    try:
+        with Campaign(args.scheduler) as campaign, Progress(len(inputs), "tradeoff") as bar:
+            measured_all = campaign.map(measure, inputs, [i[0].name for i in inputs], bar)
+    except Rend3rError as exc:
+        print(f"rend3r: error: {exc}", file=sys.stderr)
+        return 1
+    rows: list[Row] = []
+    for (program, *_), measured in zip(inputs, measured_all):
+        if isinstance(measured, str):
+            print(f"{program.name}: skipped: {measured}", file=sys.stderr)
             continue
         rows += measured
         for r in measured:

@@ -138,24 +138,28 @@ def _occurrences(records: list[dict]) -> Iterator[tuple]:
         yield (*k, seen[k])
 
 
-def _agreement(ar, work: list[dict], ref: list[dict]) -> list[tuple[dict | None, bool]]:
+def _agreement(ar, work: list[dict], ref: list[dict]) -> tuple[list[dict | None], np.ndarray, np.ndarray]:
     """Each working record's fp64 record (matched by shape, stage and occurrence, as
-    ``rend3r trace-diff`` matches) and whether the two agree: integers and flags equal,
-    values equal to the fp64 value rounded to the working format (NaN agrees with NaN)."""
+    ``rend3r trace-diff`` matches), whether the two agree (integers and flags equal, values
+    equal to the fp64 value rounded to the working format, NaN to NaN), and which records
+    are integers or flags."""
     keys = [(r["shape"], r["stage"]) for r in work]
     if keys == [(r["shape"], r["stage"]) for r in ref]:  # the same path: records pair in order
         pairs: list[dict | None] = list(ref)
     else:
         by_key = dict(zip(_occurrences(ref), ref))
         pairs = [by_key.get(key) for key in _occurrences(work)]
-    agree = [f is not None and (not isinstance(r["dec"], int) or r["dec"] == f["dec"]) for r, f in zip(work, pairs)]
-    values = [i for i, (r, f) in enumerate(zip(work, pairs)) if f is not None and not isinstance(r["dec"], int)]
-    if values:
-        a = np.array([float(work[i]["dec"]) for i in values])  # "nan", "inf" and "-inf" read as themselves
-        b = np.asarray(ar.round(np.array([float(pairs[i]["dec"]) for i in values])), dtype=np.float64)
-        for i, ok in zip(values, ((a == b) | (np.isnan(a) & np.isnan(b))).tolist()):
-            agree[i] = ok
-    return list(zip(pairs, agree))
+    n = len(work)
+    integer = np.fromiter((type(r["dec"]) is int for r in work), dtype=bool, count=n)
+    paired = np.fromiter((f is not None for f in pairs), dtype=bool, count=n)
+    # "nan", "inf" and "-inf" read as themselves; integers (at most 64-bit flags, colours,
+    # indices) compare exactly as floats below 2**53, as every one of them is
+    mine = np.array([float(r["dec"]) for r in work], dtype=np.float64)
+    theirs = np.array([float(f["dec"]) if f is not None else np.nan for f in pairs], dtype=np.float64)
+    with quiet_numpy():
+        rounded = np.asarray(ar.round(theirs), dtype=np.float64)
+    same_value = (mine == rounded) | (np.isnan(mine) & np.isnan(rounded))
+    return pairs, paired & np.where(integer, mine == theirs, same_value), integer
 
 
 #: How the shape shown is chosen: raytracing, then each raster visibility rule
@@ -178,6 +182,12 @@ def _hits(work: list[dict], ref: list[dict]) -> list[dict]:
     return [{"shape": shape, "sq_dist": mine[shape], "fp64_sq_dist": theirs.get(shape)} for shape in order]
 
 
+def _first(flags: np.ndarray) -> int | None:
+    """The index of the first true flag, None when there is none."""
+    where = np.flatnonzero(flags)
+    return int(where[0]) if len(where) else None
+
+
 def _row(record: dict, ref: dict | None, agrees: bool) -> dict:
     """A trace record with its fp64 value beside it."""
     return {**record, "fp64": None if ref is None else {"hex": ref["hex"], "dec": ref["dec"]}, "diverges": not agrees}
@@ -196,9 +206,9 @@ def history(words: Sequence[int], options, frame: int, x: int, y: int, all_shape
     work = traces.trace(version, words, options, frame, x, y)
     ref = traces.trace(version, words, reference(options), frame, x, y)
     ar = options.arith
-    agreement = _agreement(ar, work, ref)
-    first = next((i for i, (_, ok) in enumerate(agreement) if not ok), None)
-    decision = next((i for i, (_, ok) in enumerate(agreement) if not ok and isinstance(work[i]["dec"], int)), None)
+    pairs, agree, integer = _agreement(ar, work, ref)
+    first = _first(~agree)
+    decision = _first(~agree & integer)
     split = next((i for i, r in enumerate(work) if r["stage"] == "nearest"), len(work))
     shapes = {r["shape"] for r in work[:split]}
     keep = shapes
@@ -208,7 +218,7 @@ def history(words: Sequence[int], options, frame: int, x: int, y: int, all_shape
         keep |= {work[i]["shape"] for i in (first, decision) if i is not None and i < split}
     shown = [i for i in range(len(work)) if i >= split or work[i]["shape"] in keep]
     index = {i: n for n, i in enumerate(shown)}
-    records = [_row(work[i], *agreement[i]) for i in shown]
+    records = [_row(work[i], pairs[i], bool(agree[i])) for i in shown]
     return {"frame": frame, "pixel": [x, y], "precision": options.precision, "label": ar.label,
             "mode": options.mode, "shapes": len(shapes), "shapes_shown": len(keep & shapes), "records": records,
             "first_divergence": None if first is None else index[first],

@@ -30,7 +30,8 @@ def page(tmp_path):
     tests bypass it, the page itself needs no eval."""
     with sync_api.sync_playwright() as pw:
         context = pw.chromium.launch_persistent_context(str(tmp_path / "profile"), executable_path=CHROMIUM,
-                                                        args=ARGS, headless=True, bypass_csp=True)
+                                                        args=ARGS, headless=True, bypass_csp=True,
+                                                        viewport={"width": 1800, "height": 1200})
         try:
             yield context.new_page()
         finally:
@@ -39,11 +40,13 @@ def page(tmp_path):
 
 
 def _click(page, x: int, y: int) -> None:
-    """Click frame pixel (x, y) of the working-precision image, whatever its displayed scale."""
+    """Click frame pixel (x, y) of the working-precision image. The viewport shows it at its
+    natural size; mouse positions are whole CSS pixels, so the click is at the first whole
+    position inside the pixel (the image's top may be fractional)."""
     at = page.evaluate("""([x, y]) => { const img = document.getElementById('img-a');
         const r = img.getBoundingClientRect();
-        return [r.left + img.clientLeft + (x + 0.5) * img.clientWidth / img.naturalWidth,
-                r.top + img.clientTop + (y + 0.5) * img.clientHeight / img.naturalHeight]; }""", [x, y])
+        return [Math.ceil(r.left + img.clientLeft + x * img.clientWidth / img.naturalWidth),
+                Math.ceil(r.top + img.clientTop + y * img.clientHeight / img.naturalHeight)]; }""", [x, y])
     page.mouse.click(*at)
 
 

@@ -116,7 +116,10 @@ class Campaign:
                 shape = {"n_workers": slots, "threads_per_worker": 1} if self.processes else \
                     {"n_workers": 1, "threads_per_worker": slots}
                 with ctrl_c_ignored():  # worker processes inherit it: a Ctrl-C stops the run here, which stops them
+                    # no dashboard; the scheduler's HTTP server on any free port of the loopback (its
+                    # default, 8787, is taken by another campaign running here, with a warning)
                     self._cluster = LocalCluster(**shape, processes=self.processes, dashboard_address=None,
+                                                 scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                                                  silence_logs=logging.CRITICAL)
                 self._client = Client(self._cluster)
             else:

@@ -205,3 +205,16 @@ def test_ctrl_c_stops_the_local_worker_processes_at_once():
               for pid in pids) and time.monotonic() - stopped < 1:
         time.sleep(0.05)
     assert all(not os.path.exists(f"/proc/{pid}") or "zombie" in open(f"/proc/{pid}/status").read() for pid in pids)
+
+
+@needs_dask
+@pytest.mark.parametrize("processes", [False, True])
+def test_two_local_clusters_at_once_say_nothing(processes):
+    import warnings
+
+    # another campaign on this machine: its scheduler holds the HTTP port a cluster takes by default
+    with Campaign("local", workers=1) as first, warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with Campaign("local", workers=1, processes=processes) as second:
+            assert second.map(abs, [(-3,)], ["abs"], Counter()) == [3]
+        assert first.map(abs, [(-2,)], ["abs"], Counter()) == [2]

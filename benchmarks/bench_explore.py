@@ -1,0 +1,209 @@
+"""The exploration campaign on Dask: 20 programs x 12 uniform designs at 256x192.
+
+Prints, with the targets of issue 15 (docs/campaigns.md):
+
+* 1 local worker against 2 (the in-process cluster of ``rend3r explore``, a render per
+  worker thread, each render on one thread, ``--jobs 1``): the campaign's wall time, the
+  median of ``--repeat`` runs, and the speed-up (target >= 1.8x on 2 cores);
+* the scheduling overhead: (wall x workers - sum of task times) / sum of task times, the
+  task times measured inside the tasks (target <= 5%); the cluster's start is reported
+  apart;
+* the same campaign through a ``tcp://`` scheduler with two one-thread worker processes
+  this script starts on 127.0.0.1 (``dask scheduler``, ``dask worker``): ``rend3r explore``
+  writes ``results.csv`` there and on the local cluster, and the two must be identical;
+* render time of a non-native format (e6m9) and of e5m10 with ftz against fp16 (targets
+  <= 2x and <= 1x), each program rendered alone, the median of ``--repeat`` runs.
+
+Exits 1 when the two ``results.csv`` differ (or a step fails), else 0; a missed speed
+target is printed as ``MISSED``.
+
+    python benchmarks/bench_explore.py [--repeat 3] [--size 256x192]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from functools import partial
+from pathlib import Path
+
+import rend3r
+from rend3r.campaign.runner import Campaign
+from rend3r.cliutil import parse_size
+from rend3r.explore.campaign import REFERENCE, ProgramSpec, render_and_score, render_design
+from rend3r.explore.cli import load_spec
+from rend3r.progress import Progress
+
+ROOT = Path(__file__).resolve().parents[1]
+#: where the rend3r in use is imported from: the workers and commands started here import it too
+PACKAGE_PATH = str(Path(rend3r.__file__).resolve().parents[1])
+#: the 12 designs: uniform working formats from 4 to 32 bits
+FORMATS = ("e4m3", "e5m6", "fp16", "e6m9", "bf16", "e8m10", "e6m12", "fp24", "e8m15", "e8m19", "e11m22", "fp32")
+SUBNORMALS = "ftz"
+
+
+def timed(task: Callable, *args):
+    """``(seconds, task(*args))``: a campaign task that reports how long it ran."""
+    start = time.perf_counter()
+    result = task(*args)
+    return time.perf_counter() - start, result
+
+
+def campaign_run(campaign: Campaign, specs: list[ProgramSpec], size: tuple[int, int]) -> tuple[float, float]:
+    """Run explore's two stages (fp64 references, then every design scored); (wall s, sum of task s)."""
+    options = {"subnormals": SUBNORMALS, "width": size[0], "height": size[1], "jobs": 1}
+    pairs = [(s, f) for s in specs for f in FORMATS]
+    start = time.perf_counter()
+    with Progress(len(specs) + len(pairs), f"{campaign.workers} worker(s)") as bar:
+        refs = campaign.map(partial(timed, partial(render_design, precision=REFERENCE, **options)),
+                            [(s,) for s in specs], [s.name for s in specs], bar)
+        reference = {s.name: r for s, (_, r) in zip(specs, refs)}
+        scores = campaign.map(partial(timed, partial(render_and_score, **options)),
+                              [(s, f, reference[s.name]) for s, f in pairs], [f"{s.name} in {f}" for s, f in pairs], bar)
+    wall = time.perf_counter() - start
+    return wall, sum(t for t, _ in refs) + sum(t for t, _ in scores)
+
+
+def local_workers(specs: list[ProgramSpec], size: tuple[int, int], repeat: int) -> dict[int, dict[str, float]]:
+    """Per worker count: median start, wall and overhead share over ``repeat`` campaigns."""
+    found: dict[int, dict[str, list[float]]] = {}
+    for _ in range(repeat):
+        for workers in (1, 2):
+            start = time.perf_counter()
+            with Campaign("local", workers=workers) as campaign:
+                up = time.perf_counter() - start
+                wall, tasks = campaign_run(campaign, specs, size)
+            runs = found.setdefault(workers, {"start": [], "wall": [], "overhead": [], "tasks": []})
+            runs["start"].append(up)
+            runs["wall"].append(wall)
+            runs["tasks"].append(tasks)
+            runs["overhead"].append((wall * workers - tasks) / tasks)
+            print(f"  {workers} worker(s): start {up:.1f} s, campaign {wall:.1f} s, tasks {tasks:.1f} s, "
+                  f"overhead {100 * runs['overhead'][-1]:.1f}%", flush=True)
+    return {w: {k: statistics.median(v) for k, v in runs.items()} for w, runs in found.items()}
+
+
+def format_times(specs: list[ProgramSpec], size: tuple[int, int], repeat: int) -> dict[str, float]:
+    """Sum over the programs of each one's median render time (s) in fp16, e5m10 and e6m9."""
+    totals = dict.fromkeys(("fp16", "e5m10", "e6m9"), 0.0)
+    for spec in specs:
+        render_design(spec, "fp16", SUBNORMALS, *size, jobs=1)  # warm: the first render of a program pays more
+        for precision in totals:
+            times = [timed(render_design, spec, precision, SUBNORMALS, *size, 1)[0] for _ in range(repeat)]
+            totals[precision] += statistics.median(times)
+    return totals
+
+
+def package_env() -> dict[str, str]:
+    """This environment with :data:`PACKAGE_PATH` first on the module path."""
+    return {**os.environ, "PYTHONPATH": os.pathsep.join([PACKAGE_PATH, os.environ.get("PYTHONPATH", "")])}
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def start_cluster() -> tuple[str, list[subprocess.Popen]]:
+    """A ``dask scheduler`` and two one-thread ``dask worker`` processes on 127.0.0.1."""
+    from distributed import Client
+
+    address = f"tcp://127.0.0.1:{free_port()}"
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "env": package_env()}
+    processes = [subprocess.Popen(["dask", "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
+                                   "--no-dashboard"], **quiet)]
+    try:
+        with Client(address, timeout="60s") as client:
+            for name in ("a", "b"):
+                processes.append(subprocess.Popen(["dask", "worker", address, "--name", name, "--nthreads", "1",
+                                                   "--no-dashboard", "--host", "127.0.0.1"], **quiet))
+            client.wait_for_workers(2, timeout=120)
+    except BaseException:
+        stop(processes)
+        raise
+    return address, processes
+
+
+def stop(processes: list[subprocess.Popen]) -> None:
+    for p in reversed(processes):
+        p.terminate()
+    for p in reversed(processes):
+        try:
+            p.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait()
+
+
+def explore_csv(programs: list[Path], size: tuple[int, int], scheduler: str, out: Path) -> tuple[bytes, float]:
+    """``rend3r explore`` of the campaign on ``scheduler``: (results.csv, wall s of the command)."""
+    command = [sys.executable, "-m", "rend3r", "explore", *map(str, programs), "-o", str(out), "--formats",
+               ",".join(FORMATS), "--size", f"{size[0]}x{size[1]}", "--jobs", "1", "--scheduler", scheduler, "-q"]
+    start = time.perf_counter()
+    done = subprocess.run(command, env=package_env(), capture_output=True, text=True, check=False)
+    if done.returncode:
+        raise RuntimeError(f"rend3r explore --scheduler {scheduler} failed (exit {done.returncode}): "
+                           f"{done.stderr.strip()}")
+    return (out / "results.csv").read_bytes(), time.perf_counter() - start
+
+
+def verdict(ok: bool) -> str:
+    return "met" if ok else "MISSED"
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3, help="runs of each measurement; medians are printed")
+    ap.add_argument("--size", default="256x192", help="image size WxH (default 256x192)")
+    args = ap.parse_args(argv)
+    size = parse_size(args.size)
+    programs = sorted((ROOT / "programs").glob("*.asm"))
+    specs = [load_spec(p) for p in programs]
+    print(f"{len(specs)} programs x {len(FORMATS)} designs at {size[0]}x{size[1]} ({len(specs)} fp64 references "
+          f"+ {len(specs) * len(FORMATS)} scored renders), {os.cpu_count()} cores, load average "
+          f"{os.getloadavg()[0]:.1f}", flush=True)
+
+    local = local_workers(specs, size, args.repeat)
+    speedup = local[1]["wall"] / local[2]["wall"]
+    for workers, m in local.items():
+        print(f"{workers} local worker(s): campaign {m['wall']:.1f} s (cluster start {m['start']:.1f} s apart), "
+              f"task time {m['tasks']:.1f} s, scheduling overhead {100 * m['overhead']:.1f}% (median of {args.repeat})")
+    print(f"speed-up of 2 local workers over 1: {speedup:.2f}x (target >= 1.8x: {verdict(speedup >= 1.8)})")
+    worst = max(m["overhead"] for m in local.values())
+    print(f"scheduling overhead: at most {100 * worst:.1f}% of task time (target <= 5%: {verdict(worst <= 0.05)})",
+          flush=True)
+
+    totals = format_times(specs, size, args.repeat)
+    e6m9, e5m10 = totals["e6m9"] / totals["fp16"], totals["e5m10"] / totals["fp16"]
+    print(f"render time over the {len(specs)} programs: fp16 {totals['fp16']:.2f} s, e5m10 {totals['e5m10']:.2f} s, "
+          f"e6m9 {totals['e6m9']:.2f} s (median of {args.repeat}, one thread)")
+    print(f"e6m9 / fp16: {e6m9:.2f}x (target <= 2x: {verdict(e6m9 <= 2)}); "
+          f"e5m10-ftz / fp16: {e5m10:.2f}x (target <= 1x: {verdict(e5m10 <= 1)})", flush=True)
+
+    with tempfile.TemporaryDirectory() as tmp:
+        try:
+            address, processes = start_cluster()
+            try:
+                remote, remote_s = explore_csv(programs, size, address, Path(tmp) / "tcp")
+            finally:
+                stop(processes)
+            here, here_s = explore_csv(programs, size, "local", Path(tmp) / "local")
+        except (OSError, RuntimeError) as exc:  # TimeoutError (no scheduler or workers) is an OSError
+            print(f"error: {exc}", file=sys.stderr)
+            return 1
+    same = remote == here
+    print(f"rend3r explore through {address} (2 worker processes): {remote_s:.1f} s; on the local cluster: "
+          f"{here_s:.1f} s; results.csv {'identical' if same else 'DIFFERENT'} ({len(here.splitlines()) - 1} rows)")
+    return 0 if same else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -4,9 +4,10 @@
 
 Rows (per parser): ``.svo`` files (a valid octree with and without far pointers, mutated
 by bit flips, byte pokes, 16-bit pointer overwrites and truncation, rendered with the
-numba kernel, the numpy kernel or the float64 reference) and OBJ, PLY, STL meshes
+numba kernel, the numpy kernel or the float64 reference), OBJ, PLY, STL meshes
 (mutated valid meshes, hostile tokens, huge indices, NaN/inf and binary garbage, built
-with ``svo build``). Prints ``harness.HEADER`` and one ``Tally.report()`` row each, then
+with ``svo build``) and binvox grids (the same mutations and hostile headers and runs,
+built with ``svo build``). Prints ``harness.HEADER`` and one ``Tally.report()`` row each, then
 the first failures on stderr. Exit status 1 if any case failed.
 """
 
@@ -23,7 +24,7 @@ import harness  # noqa: E402
 
 TOKENS = [b"nan", b"inf", b"-inf", b"1e308", b"-1e308", b"100000000000000000000", b"0", b"-1",
           b"4294967296", b"\xff\xfe", b"f ", b"v ", b"element face 99999999\n", b"property list float float x\n",
-          b"\n", b" ", b"/", b"end_header\n", b"solid", b"vertex "]
+          b"\n", b" ", b"/", b"end_header\n", b"solid", b"vertex ", b"dim 65536 65536 65536\n", b"\x01\xff" * 8]
 
 
 def mutate(data: bytes, rng: random.Random, tokens: bool) -> bytes:
@@ -48,7 +49,7 @@ def mutate(data: bytes, rng: random.Random, tokens: bool) -> bytes:
 
 def seeds(work: Path) -> dict[str, list[Path]]:
     """Valid inputs to mutate, made with the CLI itself."""
-    made = {"svo": [], "obj": [], "ply": [], "stl": []}
+    made = {"svo": [], "obj": [], "ply": [], "stl": [], "binvox": [work / "seed.binvox"]}
     for ext, extra in (("obj", []), ("ply", []), ("ply", ["--ascii"]), ("stl", []), ("stl", ["--ascii"])):
         path = work / f"seed{len(made[ext])}.{ext}"
         check(harness.run_case(["svo", "model", "sphere", "--detail", "6", "-o", str(path), *extra]))
@@ -56,7 +57,7 @@ def seeds(work: Path) -> dict[str, list[Path]]:
     for bits in ("4", "15"):
         path = work / f"seed{bits}.svo"
         check(harness.run_case(["svo", "build", str(made["obj"][0]), "-o", str(path), "--depth", "5",
-                                "--ptr-bits", bits]))
+                                "--ptr-bits", bits, "--binvox", str(made["binvox"][0])]))
         made["svo"].append(path)
     return made
 
@@ -83,6 +84,11 @@ def mesh_case(rng: random.Random, base: Path, case: Path, out: Path) -> list[str
             "--max-memory", "1G"]
 
 
+def binvox_case(rng: random.Random, base: Path, case: Path, out: Path) -> list[str]:
+    case.write_bytes(mutate(base.read_bytes(), rng, tokens=True))
+    return ["svo", "build", str(case), "-o", str(out), "--max-memory", "1G"]
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=200, help="cases per parser")
@@ -96,7 +102,8 @@ def main() -> int:
         made = seeds(work)
         print(harness.HEADER)
         for name, key, make in ((".svo", "svo", svo_case), ("OBJ", "obj", mesh_case),
-                                ("PLY", "ply", mesh_case), ("STL", "stl", mesh_case)):
+                                ("PLY", "ply", mesh_case), ("STL", "stl", mesh_case),
+                                ("binvox", "binvox", binvox_case)):
             tally = harness.Tally(name)
             for i in range(args.cases):
                 case, out = work / f"case.{key}", work / ("out.png" if key == "svo" else "out.svo")

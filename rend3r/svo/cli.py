@@ -130,9 +130,10 @@ def build_cmd(mesh: str, output: str, depth: int | None, solid: bool, ptr_bits: 
     """
     import numpy as np
 
+    from .binvox import encode_binvox_codes, read_binvox_codes
     from .budget import check_budget, default_budget
     from .fileformat import SvoModel, encode_svo
-    from .mesh_io import encode_binvox_codes, read_binvox_codes, read_mesh
+    from .mesh_io import read_mesh
     from .octree import build_octree_codes
     from .voxelize import voxelize_codes
 

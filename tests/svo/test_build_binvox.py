@@ -7,19 +7,22 @@ import sys
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from hypothesis import given
+from hypothesis import strategies as st
 
 from rend3r.cli import main
 from rend3r.errors import Rend3rError
-from rend3r.svo import mesh_io
+from rend3r.svo import binvox
+from rend3r.svo.binvox import decode_binvox, decode_binvox_codes, encode_binvox, encode_binvox_codes
 from rend3r.svo.budget import BASE, SURFACE_BYTES, estimate_voxels
-from rend3r.svo.mesh_io import (decode_binvox, decode_binvox_codes, encode_binvox, encode_binvox_codes, encode_mesh,
-                                read_mesh)
+from rend3r.svo.mesh_io import encode_mesh, read_mesh
 from rend3r.svo.models import make_model
 from rend3r.svo.octree import morton_decode, morton_encode
 from rend3r.svo.voxelize import fit_bounds, voxelize_codes
 
 from .conftest import random_voxels
 from .test_budget import _PEAK
+from .test_fuzz import FUZZ
 
 
 def _file(dim: str, body: bytes) -> bytes:
@@ -75,8 +78,8 @@ def test_batches_and_blocks_decode_the_same_codes(monkeypatch):
     want = np.unique(morton_encode(coords, 5))
     codes, dim, translate, scale = decode_binvox_codes(data)
     assert np.array_equal(codes, want) and dim == 32 and translate.tolist() == [1, 2, 3] and scale == 4
-    monkeypatch.setattr(mesh_io, "_RUN_BLOCK", 3)
-    monkeypatch.setattr(mesh_io, "_VOXEL_BATCH", 7)
+    monkeypatch.setattr(binvox, "_RUN_BLOCK", 3)
+    monkeypatch.setattr(binvox, "_VOXEL_BATCH", 7)
     assert np.array_equal(decode_binvox_codes(data)[0], want)
 
 
@@ -130,6 +133,27 @@ def test_code_and_coordinate_encoders_agree_across_batches(monkeypatch):
         want = encode_binvox(coords, 1 << depth, (1, 2, 3), 4)
         codes = np.sort(morton_encode(coords, depth))
         for batch in (1, 5, 1 << 19):
-            monkeypatch.setattr(mesh_io, "_VOXEL_BATCH", batch)
+            monkeypatch.setattr(binvox, "_VOXEL_BATCH", batch)
             assert encode_binvox_codes(codes, depth, (1, 2, 3), 4) == want
             assert decode_binvox(want)[0].tolist() == morton_decode(codes, depth).tolist()
+
+
+_SEED = encode_binvox(random_voxels(4, 500, 2), 16)
+
+
+@FUZZ
+@given(st.lists(st.tuples(st.integers(0, len(_SEED) - 1), st.integers(0, 255)), max_size=6),
+       st.integers(0, len(_SEED)))
+def test_mutated_binvox_decodes_or_is_refused(pokes, keep):
+    """Poked and truncated files: valid codes of the grid, or a Rend3rError naming the file."""
+    data = bytearray(_SEED)
+    for pos, value in pokes:
+        data[pos] = value
+    try:
+        codes, dim, _, _ = decode_binvox_codes(bytes(data[:keep]), "m.binvox")
+    except Rend3rError as exc:
+        assert str(exc).startswith("m.binvox: ")
+        return
+    depth = max((dim - 1).bit_length(), 1)
+    assert np.all(codes[1:] > codes[:-1]) and (len(codes) == 0 or 0 <= codes[0] <= codes[-1] < 8 ** depth)
+    assert np.all(morton_decode(codes, depth) < dim)

@@ -5,8 +5,8 @@ import pytest
 import trimesh
 
 from rend3r.errors import Rend3rError
-from rend3r.svo.mesh_io import (decode_binvox, encode_binvox, read_binvox, read_mesh,
-                                write_binvox, write_mesh)
+from rend3r.svo.binvox import decode_binvox, encode_binvox, read_binvox, write_binvox
+from rend3r.svo.mesh_io import read_mesh, write_mesh
 from rend3r.svo.models import torus
 
 from .conftest import random_voxels

@@ -12,6 +12,8 @@ counts). Three rows:
 - emulate values: real programs with float16 operands replaced by inf, NaN, 65504 and
   subnormals, in every mode and precision; no numpy warning may reach stderr.
 
+Exit status 1 if any case failed, left an output or printed a numpy warning.
+
 Usage: ``python fuzz/emulate.py --cases N [--seed S]``.
 """
 
@@ -190,6 +192,7 @@ def main() -> None:
     print(f"\noutputs left after a failed emulate: {left}; numpy warnings on stderr: {warned}")
     for tally in (traces, options, values):
         tally.print_failures()
+    sys.exit(1 if left or warned or any(t.failures for t in (traces, options, values)) else 0)
 
 
 if __name__ == "__main__":

@@ -8,6 +8,8 @@ hostile snippets, deletion, duplication, CRLF) and runs ``rend3r disasm FILE`` i
 files at and over the size and word limits.
 
     python fuzz/memory.py --cases 150 [--seed 1]
+
+Exit status 1 if any case failed.
 """
 
 from __future__ import annotations
@@ -111,7 +113,7 @@ def run_format(fmt: str, images: list[bytes], cases: int, rng: random.Random, wo
     return tally
 
 
-def main() -> None:
+def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=150, help="mutated cases per format (extremes come on top)")
     ap.add_argument("--seed", type=int, default=1)
@@ -121,11 +123,14 @@ def main() -> None:
         workdir = Path(tmp)
         images = seeds(workdir)
         print(harness.HEADER)
+        failed = False
         for fmt in FORMATS:
             tally = run_format(fmt, images[fmt], args.cases, rng, workdir)
             print(tally.report(), flush=True)
             tally.print_failures()
+            failed |= bool(tally.failures)
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -83,12 +83,18 @@ class View:
         self._polling = True
         try:
             changed = await IOLoop.current().run_in_executor(self.watch, self.source.refresh)
+        except Exception as exc:  # a bug in reloading must not stop the server or print a traceback
+            print(f"rend3r view: cannot reload {self.source.path}: {type(exc).__name__}: {exc}", file=sys.stderr)
+            return
         finally:
             self._polling = False
         if changed:
             message = json.dumps({"type": "reload", **status(self)})
             for s in list(self.sockets):
-                s.write_message(message)
+                try:
+                    s.write_message(message)
+                except tornado.websocket.WebSocketClosedError:
+                    self.sockets.discard(s)
 
     def good(self):
         """The last program that loaded; 409 when none has."""

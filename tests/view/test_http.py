@@ -145,6 +145,7 @@ def test_live_reload_pushes_over_the_websocket_and_keeps_the_last_good_frame_on_
         assert msg["message"].startswith(f"{sphere_program}:7:7: error:")
         status, kind, body = s.request("/api/image/frame.png?size=64x48")
         assert status == 200 and np.array_equal(_png(body), green)
+    assert "Traceback" not in s.stderr_text and "rend3r view:" not in s.stderr_text
 
 
 def test_an_included_file_that_only_defines_names_is_watched(tmp_path):

@@ -13,7 +13,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .params import MAX_FRAMES, RequestError
+from .params import RequestError
 
 #: Bytes of rendered frames kept for reuse (older option sets are dropped first).
 CACHE_BYTES = 128 << 20
@@ -40,11 +40,11 @@ def png(rgb888: np.ndarray) -> bytes:
     return buf.getvalue()
 
 
-def frame_count(words: Sequence[int], options) -> int:
-    """Frames the program renders (a looping program: :data:`MAX_FRAMES`)."""
+def frame_count(words: Sequence[int], options, most: int) -> int:
+    """Frames the program renders, at most ``most`` (a looping program: ``most``)."""
     from ..emu.processor import execute
 
-    count = execute(words, options, MAX_FRAMES).frames
+    count = execute(words, options, most).frames
     if count == 0:
         raise RequestError("the program renders no frame (no nf is executed)", 422)
     return count

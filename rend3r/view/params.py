@@ -17,8 +17,8 @@ MAX_PIXELS = 1 << 20
 MAX_VALUE = 64
 #: Most ``quirk`` values in one request (there are 16 quirks).
 MAX_QUIRKS = 32
-#: Frames a looping program is shown with (the slider's range).
-MAX_FRAMES = 256
+#: Most frames a view shows of a program (``--frames``: a looping program shows this many).
+MAX_FRAMES = 4096
 
 Args = Mapping[str, Sequence[bytes]]
 

@@ -64,8 +64,9 @@ def static_files() -> dict[str, tuple[bytes, str]]:
 class View:
     """What the handlers share: the program, caches, the worker thread and the live sockets."""
 
-    def __init__(self, program: str, token: str | None, hosts: set[str]) -> None:
+    def __init__(self, program: str, token: str | None, hosts: set[str], frames: int) -> None:
         self.source = ProgramSource(program)
+        self.max_frames = frames
         self.token, self.hosts = token, hosts
         self.files = static_files()
         self.frames = fr.FrameCache()
@@ -233,7 +234,7 @@ def _images(view: View, args) -> tuple[dict, dict[str, bytes] | None]:
     from ..emu.image import rgb565_to_rgb888
 
     good, options = _options(view, args)
-    count = fr.frame_count(good.words, options)
+    count = fr.frame_count(good.words, options, view.max_frames)
     number = _frame_number(args, count)
     version = view.source.state.version
     work = rgb565_to_rgb888(view.frames.frame(version, good.words, options, number))
@@ -264,7 +265,7 @@ class Pixel(Handler):
 
         def history() -> dict:
             good, options = _options(self.view, args)
-            number = _frame_number(args, fr.frame_count(good.words, options))
+            number = _frame_number(args, fr.frame_count(good.words, options, self.view.max_frames))
             x, y = integer(args, "x", 0, options.width - 1), integer(args, "y", 0, options.height - 1)
             return fr.history(good.words, options, number, x, y, one(args, "shapes", "auto") == "all",
                               self.view.traces, self.view.source.state.version)
@@ -330,10 +331,11 @@ def new_token() -> str:
     return secrets.token_urlsafe(18)
 
 
-async def serve(program: str, host: str, port: int, on_ready) -> None:
-    """Serve ``program`` on ``host:port`` until cancelled; ``on_ready(url)`` once listening."""
+async def serve(program: str, host: str, port: int, frames: int, on_ready) -> None:
+    """Serve ``program`` (at most ``frames`` of its frames) on ``host:port`` until cancelled;
+    ``on_ready(url, status)`` once listening."""
     token = None if is_loopback(host) else new_token()
-    view = View(program, token, set())
+    view = View(program, token, set(), frames)
     await view.poll()
     sockets = bind_sockets(port, host)
     server = HTTPServer(make_app(view), max_body_size=1 << 16)

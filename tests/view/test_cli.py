@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 from click.testing import CliRunner
 
@@ -18,6 +19,16 @@ def test_help_has_an_example_and_the_options():
     assert "rend3r view programs/shadow.asm" in result.output
     for option in ("--port N", "--host H", "--open"):
         assert option in result.output
+
+
+def test_frames_bounds_a_looping_program_and_is_checked():
+    program = str(Path(__file__).resolve().parents[2] / "programs" / "animation.asm")
+    with serve(program, "--frames", "8") as s:
+        assert s.json("/api/frame?size=32x24")[1]["frames"] == 8
+        status, err = s.json("/api/frame?size=32x24&frame=8")
+        assert status == 400 and "frame 8 is outside 0..7" in err["error"]
+    bad = CliRunner().invoke(main, ["view", program, "--frames", "0"])
+    assert bad.exit_code == 2 and "--frames" in bad.output
 
 
 def test_a_missing_program_is_refused_before_listening(tmp_path):

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import socket
 import statistics
 import subprocess
 import sys
@@ -40,6 +39,9 @@ from rend3r.cliutil import parse_size
 from rend3r.explore.campaign import REFERENCE, ProgramSpec, render_and_score, render_design
 from rend3r.explore.cli import load_spec
 from rend3r.progress import Progress
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from dask_cluster import localhost_cluster  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 #: where the rend3r in use is imported from: the workers and commands started here import it too
@@ -106,43 +108,6 @@ def package_env() -> dict[str, str]:
     return {**os.environ, "PYTHONPATH": os.pathsep.join([PACKAGE_PATH, os.environ.get("PYTHONPATH", "")])}
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def start_cluster() -> tuple[str, list[subprocess.Popen]]:
-    """A ``dask scheduler`` and two one-thread ``dask worker`` processes on 127.0.0.1."""
-    from distributed import Client
-
-    address = f"tcp://127.0.0.1:{free_port()}"
-    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "env": package_env()}
-    processes = [subprocess.Popen(["dask", "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
-                                   "--no-dashboard"], **quiet)]
-    try:
-        with Client(address, timeout="60s") as client:
-            for name in ("a", "b"):
-                processes.append(subprocess.Popen(["dask", "worker", address, "--name", name, "--nthreads", "1",
-                                                   "--no-dashboard", "--host", "127.0.0.1"], **quiet))
-            client.wait_for_workers(2, timeout=120)
-    except BaseException:
-        stop(processes)
-        raise
-    return address, processes
-
-
-def stop(processes: list[subprocess.Popen]) -> None:
-    for p in reversed(processes):
-        p.terminate()
-    for p in reversed(processes):
-        try:
-            p.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            p.kill()
-            p.wait()
-
-
 def explore_csv(programs: list[Path], size: tuple[int, int], scheduler: str, out: Path) -> tuple[bytes, float]:
     """``rend3r explore`` of the campaign on ``scheduler``: (results.csv, wall s of the command)."""
     command = [sys.executable, "-m", "rend3r", "explore", *map(str, programs), "-o", str(out), "--formats",
@@ -190,11 +155,8 @@ def main(argv: list[str] | None = None) -> int:
 
     with tempfile.TemporaryDirectory() as tmp:
         try:
-            address, processes = start_cluster()
-            try:
+            with localhost_cluster(PACKAGE_PATH) as (address, _):
                 remote, remote_s = explore_csv(programs, size, address, Path(tmp) / "tcp")
-            finally:
-                stop(processes)
             here, here_s = explore_csv(programs, size, "local", Path(tmp) / "local")
         except (OSError, RuntimeError) as exc:  # TimeoutError (no scheduler or workers) is an OSError
             print(f"error: {exc}", file=sys.stderr)

@@ -4,12 +4,11 @@ svo sweep's traces and simulations)."""
 
 from __future__ import annotations
 
-import os
 import re
 import shutil
 import signal
-import socket
 import subprocess
+import sys
 import time
 from functools import partial
 from pathlib import Path
@@ -21,6 +20,9 @@ from rend3r.campaign.runner import Campaign, dask_installed
 from rend3r.cli import main
 from rend3r.errors import Rend3rError
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+from dask_cluster import localhost_cluster  # noqa: E402
+
 pytestmark = [
     pytest.mark.skipif(not dask_installed(), reason="Dask distributed is not installed (pip install 'rend3r[campaign]')"),
     pytest.mark.skipif(shutil.which("dask") is None, reason="the dask command (dask scheduler, dask worker) is not on PATH"),
@@ -30,39 +32,12 @@ PROGRAMS = Path(__file__).parents[2] / "programs"
 NAMES = ("sphere.asm", "shadow.asm", "tri_cube.asm", "lights.asm")
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @pytest.fixture
 def cluster():
     """``(address, processes)``: a scheduler and two one-thread workers without nannies (a
     killed worker stays dead), all stopped at the end."""
-    from distributed import Client
-
-    address = f"tcp://127.0.0.1:{free_port()}"
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[2])}
-    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "env": env}
-    processes = [subprocess.Popen(["dask", "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
-                                   "--no-dashboard"], **quiet)]
-    try:
-        with Client(address, timeout="30s") as client:
-            for name in ("a", "b"):
-                processes.append(subprocess.Popen(["dask", "worker", address, "--name", name, "--nthreads", "1",
-                                                   "--no-nanny", "--no-dashboard", "--host", "127.0.0.1"], **quiet))
-            client.wait_for_workers(2, timeout=60)
-        yield address, processes
-    finally:
-        for p in reversed(processes):
-            p.terminate()
-        for p in reversed(processes):
-            try:
-                p.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait()
+    with localhost_cluster(str(Path(__file__).parents[2]), nanny=False) as found:
+        yield found
 
 
 def explore(out: Path, scheduler: str):

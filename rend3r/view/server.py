@@ -20,6 +20,7 @@ from concurrent.futures import ThreadPoolExecutor
 from importlib import resources
 from pathlib import Path
 
+import numpy as np
 import tornado.web
 import tornado.websocket
 from tornado.httpserver import HTTPServer
@@ -229,8 +230,8 @@ def _frame_number(args, count: int) -> int:
     return integer(args, "frame", 0, count - 1, 0)
 
 
-def _images(view: View, args) -> tuple[dict, dict[str, bytes] | None]:
-    """The frame's figures, and with ``images`` its three pictures."""
+def _images(view: View, args) -> tuple[dict, dict[str, np.ndarray]]:
+    """The frame's figures, and its three pictures (RGB888): the frame, fp64's, the difference."""
     from ..emu.image import rgb565_to_rgb888
 
     good, options = _options(view, args)
@@ -267,8 +268,11 @@ class Pixel(Handler):
             good, options = _options(self.view, args)
             number = _frame_number(args, fr.frame_count(good.words, options, self.view.max_frames))
             x, y = integer(args, "x", 0, options.width - 1), integer(args, "y", 0, options.height - 1)
-            return fr.history(good.words, options, number, x, y, one(args, "shapes", "auto") == "all",
-                              self.view.traces, self.view.source.state.version)
+            shapes = one(args, "shapes", "hit")
+            if shapes not in ("hit", "all"):
+                raise RequestError(f"shapes: hit or all, not {shapes!r}")
+            return fr.history(good.words, options, number, x, y, shapes == "all", self.view.traces,
+                              self.view.source.state.version)
 
         self.finish(await self.run(history))
 

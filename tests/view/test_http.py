@@ -248,6 +248,7 @@ def test_only_the_pages_own_files_and_the_program_are_served(tmp_path, sphere_pr
     ("/api/pixel?x=a&y=0", 400, "integer"),
     ("/api/pixel?y=0", 400, "x is required"),
     ("/api/pixel?x=%ff&y=0", 400, ""),
+    ("/api/pixel?x=0&y=0&shapes=some", 400, "shapes: hit or all"),
     ("/api/svo/ray?x=0&y=0", 404, ".svo"),
     ("/api/image/other.png", 404, "no such page"),
 ])

@@ -57,7 +57,7 @@ def _frame_bytes(page) -> str:
         c.getContext('2d').drawImage(img, 0, 0); return c.toDataURL(); }""")
 
 
-def test_a_clicked_pixel_shows_the_values_trace_pixel_prints(page, tmp_path):
+def test_a_clicked_pixel_shows_the_values_trace_pixel_prints_and_follows_the_precision(page, tmp_path):
     program = Path(__file__).resolve().parents[2] / "programs" / "shadow.asm"
     result = CliRunner().invoke(main, ["emulate", str(program), "-o", str(tmp_path / "f.png"), "-q",
                                        "--trace-pixel", "250,200"])
@@ -70,6 +70,12 @@ def test_a_clicked_pixel_shows_the_values_trace_pixel_prints(page, tmp_path):
         assert page.text_content("#pixel-title").startswith("pixel 250,200")
         rows = page.eval_on_selector_all("#history tbody tr", "rows => rows.map(r => [...r.cells].map(c => c.textContent))")
         first = page.eval_on_selector_all("#history tbody tr.first", "rows => rows.map(r => r.dataset.index)")
+        assert page.locator("#images .marker:not([hidden])").count() == 3  # the pixel outlined on each image
+        page.fill("#precision", "fp64")
+        page.dispatch_event("#precision", "change")
+        page.wait_for_function("document.getElementById('pixel-summary').textContent.startsWith('fp64')")
+        assert page.locator("#history tbody tr").count() == len(rows)
+        assert page.locator("#history tbody tr.diverges").count() == 0  # fp64 against itself
     shown = [[r[0], r[1], r[2], r[3]] for r in rows]
     assert shown == [["" if w["shape"] is None else str(w["shape"]), w["stage"], w["hex"], _js(w["dec"])] for w in want]
     assert len(first) == 1

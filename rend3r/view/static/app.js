@@ -72,6 +72,7 @@ function setupControls(st) {
   }
   $("frame").addEventListener("input", () => { $("frame-number").textContent = $("frame").value; });
   for (const id of ["img-a", "img-b", "img-c"]) $(id).addEventListener("click", (ev) => pick(ev));
+  window.addEventListener("resize", mark);
 }
 
 function loadImage(img, src) {
@@ -88,6 +89,7 @@ async function refresh() {
   showError("");
   try {
     if (state.kind === "svo") await refreshSvo(); else await refreshFrames();
+    mark();
     if (picked) await showPixel();
   } catch (e) {
     showError(e.message);
@@ -125,7 +127,22 @@ function pick(ev) {
   const x = Math.floor((ev.clientX - r.left - img.clientLeft) * img.naturalWidth / img.clientWidth);
   const y = Math.floor((ev.clientY - r.top - img.clientTop) * img.naturalHeight / img.clientHeight);
   picked = [Math.min(Math.max(x, 0), img.naturalWidth - 1), Math.min(Math.max(y, 0), img.naturalHeight - 1)];
+  mark();
   showPixel().catch((e) => showError(e.message));
+}
+
+function mark() {
+  // outline the picked pixel on each image (shown at whatever scale the page gives it)
+  for (const img of document.querySelectorAll("#images img")) {
+    const marker = img.nextElementSibling;
+    marker.hidden = !picked || !img.naturalWidth || img.parentElement.hidden;
+    if (marker.hidden) continue;
+    const sx = img.clientWidth / img.naturalWidth, sy = img.clientHeight / img.naturalHeight;
+    marker.style.left = `${img.offsetLeft + img.clientLeft + picked[0] * sx}px`;
+    marker.style.top = `${img.offsetTop + img.clientTop + picked[1] * sy}px`;
+    marker.style.width = `${sx}px`;
+    marker.style.height = `${sy}px`;
+  }
 }
 
 function cell(row, text) {

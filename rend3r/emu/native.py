@@ -30,12 +30,10 @@ B_CENTER, B_SMIN, B_SMAX, B_COLUMNS = 0, 3, 4, 5
 CAM_ORIGIN, CAM_TMIN, CAM_TMAX, CAM_Z, CAM_ROT, CAM_COLUMNS = 0, 3, 4, 5, 6, 10
 LT_KIND, LT_LOC, LT_DIR, LT_INTENSITY, LT_COLUMNS = 0, 1, 4, 7, 8
 LIGHT_DIRECTIONAL, LIGHT_POINT = 1, 2
-GF_COLUMNS, GS_COLUMNS, BOX_COLUMNS = 6, 3, 7
-GF_SU, GF_SV = 4, 5  # a face's cells per unit of u and of v
 TRACE_SHAPE_VALUES, TRACE_LIGHT_VALUES = 22, 12
 OUT_TESTS, OUT_NAN_TESTS, OUT_SHADOW_RAYS, OUT_HITS, OUT_LO, OUT_HI, OUT_COLUMNS = 0, 1, 2, 3, 4, 7, 10
 PC_COLUMNS = 7
-CONE_COLUMNS = 6  # cone_balls: unit axis, half-angle, its sine and cosine
+BV_FLOOR, BV_COLUMNS = 6, 7  # shape hierarchy node boxes: lo, hi corners, least depth floor
 
 
 class Format(Structure):
@@ -57,26 +55,24 @@ class Shapes(Structure):
                 ("tiny", c_double), ("format", POINTER(Format))]
 
 
-class Grid(Structure):
-    _fields_ = [("faces", c_void_p), ("shape", c_void_p), ("start", c_void_p), ("start_count", c_int64),
-                ("entries", c_void_p), ("glob", c_void_p), ("nglob", c_int64), ("u_at", c_void_p),
-                ("v_at", c_void_p), ("n_u", c_int64), ("n_v", c_int64), ("block", c_int64), ("block_rows", c_int64),
-                ("u_sign", c_double), ("v_sign", c_double), ("reach", c_void_p)]
+class Bvh(Structure):
+    _fields_ = [("node", c_void_p), ("items", c_void_p), ("box", c_void_p), ("nodes", c_int64), ("always", c_void_p),
+                ("nalways", c_int64)]
 
 
 class Band(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("cam", c_void_p), ("xs", c_void_p), ("ys", c_void_p),
                 ("rotated", c_int32), ("lit", c_int32), ("width", c_int64), ("row0", c_int64), ("row_magic", c_uint64),
-                ("dirs", c_void_p), ("pc", c_void_p), ("floor", c_void_p), ("grid", Grid),
-                ("bucket_start", c_void_p), ("bucket_pixels", c_void_p), ("slot", c_void_p), ("sqd", c_void_p),
+                ("dirs", c_void_p), ("pc", c_void_p), ("floor", c_void_p), ("tree", Bvh),
+                ("slot", c_void_p), ("sqd", c_void_p),
                 ("pt", c_void_p), ("nm", c_void_p), ("npix", c_int64), ("bad", c_void_p), ("nan_px", c_void_p)]
 
 
 class LightPass(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("band", POINTER(Band)), ("light", c_void_p), ("scale", c_double * 3),
-                ("frame", c_double * 6), ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
+                ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
                 ("first", c_int32), ("along", c_void_p), ("behind", c_void_p), ("l_hat", c_double * 3),
-                ("l_len", c_double), ("radius", c_void_p), ("reach", c_void_p), ("grid", Grid),
+                ("l_len", c_double), ("radius", c_void_p), ("tree", Bvh), ("keys", c_void_p),
                 ("acc", c_void_p)]
 
 
@@ -105,7 +101,6 @@ SUFFIXES = {("fp16", True): "h16", ("fp16", False): "h16i", ("fp32", True): "f32
 FORMAT = "fmt"
 _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and instruction set
     "directions": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
-    "pixel_cells": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "nearest": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "origin_terms": (None, [POINTER(Shapes), c_void_p]),
     "shape_tables": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p,
@@ -119,16 +114,13 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
                          c_void_p]),
 }
 _PLAIN = {
-    "grid_footprints": (None, [POINTER(Grid), c_int32, c_void_p, c_void_p, c_int64, c_void_p]),
-    "grid_fill": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_int32]),
-    "behind_keys": (None, [c_void_p, c_void_p, c_int64, c_double, c_double, c_void_p]),
-    "behind_reach": (None, [c_void_p, c_int64, c_int64, c_void_p, c_void_p, c_void_p]),
-    "cone_balls": (None, [c_void_p, c_void_p, c_int64, c_void_p]),
-    "cone_reach": (None, [c_void_p, c_void_p, c_int64, c_int64, c_void_p, c_void_p]),
+    "behind_keys": (None, [c_void_p, c_void_p, c_int64, c_double, c_void_p]),
+    "bvh_keys": (None, [POINTER(Bvh), c_void_p, c_void_p]),
+    "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p]),
+    "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_void_p, c_void_p, c_void_p]),
     "bound_radii": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_int32, c_void_p]),
     "bound_floors": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double,
                             c_void_p]),
-    "bucket_sort": (None, [c_void_p, c_int64, c_int64, c_void_p, c_void_p]),
     "have_avx2": (c_int32, []),
     "bound_primary": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_void_p]),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),

@@ -6,16 +6,18 @@ band per thread when there are few shapes per pixel, else each band's steps spli
 the threads (every pixel is computed the same way whatever the split, so the image does
 not depend on it). Per band:
 
-1. primary directions and their per-face (u, v) boxes (``directions``);
-2. a grid of the shapes each primary ray must test, front to back by depth floor
-   (:mod:`.grids`, :mod:`.bounds`);
-3. the nearest hit of every pixel, its hit point and normal (``nearest``);
-4. per light, a grid of the shapes each shadow ray must test, then the light's colour
-   with its shadow rays (``light_pass``);
+1. the primary directions' shortest and longest length (``directions`` stores a rotated
+   camera's directions);
+2. the shape hierarchy's boxes for the primary rays, from the shapes' cull radii and
+   depth floors (:mod:`.bvh`, :mod:`.bounds`; the tree itself is built once per frame);
+3. the nearest hit of every pixel, its hit point and normal (``nearest``, packets of a
+   row's pixels walking the tree nearest node first);
+4. per light, the hierarchy's boxes for its shadow rays, then the light's colour with
+   its shadow rays (``light_pass``);
 5. colours, depth and provenance (``finish``).
 
-``docs/emulator.md`` sections 4-7 give the order of operations and why the grids never
-change a pixel; :mod:`.reference` is the plain renderer the tests compare with.
+``docs/emulator.md`` sections 4-7 give the order of operations and why the hierarchy
+never changes a pixel; :mod:`.reference` is the plain renderer the tests compare with.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import numpy as np
 
 from ..isa import Table, lookup
 from ..isa.tables import PROP_LIMIT, SHAPE_TYPE_CODES
-from . import bounds, grids, native, threads
+from . import bounds, bvh, native, threads
 from .arith import PRECISIONS, Arith
 from .camera import camera_rays
 from .frame import Frame
@@ -70,6 +72,7 @@ class _Frame:
     light_rows: np.ndarray
     jobs: int
     shapes: native.Shapes
+    tree: bvh.Tree
 
     @property
     def fp16(self) -> bool:
@@ -131,7 +134,7 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
         native.kernel("origin_terms", ar)(byref(view), native.ptr(cam, dtype, (native.CAM_COLUMNS,)))
     return _Frame(ar, dtype, cam, np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype),
                   rays.rotation is not None, sf, si, index, bnd, bounded, lights,
-                  _light_rows(lights, dtype), options.jobs or threads.available_cores(), view)
+                  _light_rows(lights, dtype), options.jobs or threads.available_cores(), view, bvh.build(bnd, bounded))
 
 
 #: The shape table's columns the kernels read, and the type codes of the normal forms.
@@ -228,15 +231,6 @@ def _report(outs: np.ndarray) -> np.ndarray:
     return out
 
 
-def _buckets(cells: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """Items by bucket (``cells``: each item's bucket, negative: none): (starts, items)."""
-    start = np.empty(count + 1, np.int64)
-    items = np.empty(len(cells), np.int32)
-    native.library().bucket_sort(native.ptr(cells, np.int32, (None,)), len(cells), count, start.ctypes.data,
-                                 items.ctypes.data)
-    return start, items
-
-
 def _add(total: FrameStats, band: FrameStats) -> None:
     """A band's counts added to the frame's."""
     for name in _BAND_COUNTS:
@@ -262,24 +256,17 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
                        native.ptr(fr.xs, dtype, (w,)), native.ptr(fr.ys, dtype, (options.height,)),
                        int(fr.rotated), int(lit), w, row0, native.row_magic(w))
     band.npix = n_pix
-    pixels, boxes = _pixel_grid(fr, row0, row1)
-    if pixels is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
+    extent = _extent(fr, row0, row1)
+    if extent is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
         a["dirs"] = np.empty((n_pix, 4), dtype)
         band.dirs = a["dirs"].ctypes.data
-        boxes = grids.merge_boxes(_run(fr.jobs, n_pix, fr.kernel("directions"), band, grids.EMPTY_BOXES))
-    grid, floor, pc = _primary_grid(fr, boxes, pixels)
-    band.pc, band.floor, band.grid = pc.ctypes.data, floor.ctypes.data, grid.struct()
+        parts = _run(fr.jobs, n_pix, fr.kernel("directions"), band, np.array([0.0, np.inf, 0.0]))
+        extent = (float(parts[:, 1].min()), float(parts[:, 2].max())) if parts[:, 0].sum() else (0.0, 0.0)
+    box, floor, pc = _primary_tree(fr, *extent)
+    band.pc, band.floor, band.tree = pc.ctypes.data, floor.ctypes.data, fr.tree.struct(box)
     for name in ("slot", "sqd", "pt", "nm", "bad", "nan_px"):
         setattr(band, name, a[name].ctypes.data)
-    packets = grid.cells
-    if pixels is None:  # pixels by cell, the last bucket for rays outside the grid
-        a["cells"] = np.empty(n_pix, np.int32)
-        _run(fr.jobs, n_pix, fr.kernel("pixel_cells"), band, a["cells"].ctypes.data)
-        a["start"], a["pixels"] = _buckets(a["cells"], grid.cells + 1)
-        band.bucket_start, band.bucket_pixels = a["start"].ctypes.data, a["pixels"].ctypes.data
-        packets += 1
-    per_cell = n_pix / max(1, grid.cells)
-    c = _report(_run(fr.jobs, packets, fr.kernel("nearest"), band, _OUT, max(1, int(MIN_CHUNK / per_cell))))
+    c = _report(_run(fr.jobs, row1 - row0, fr.kernel("nearest"), band, _OUT, max(1, MIN_CHUNK // w)))
     st.tests += int(c[native.OUT_TESTS])
     st.nan_tests += int(c[native.OUT_NAN_TESTS])
     st.skipped += n_pix * n - int(c[native.OUT_TESTS])
@@ -293,50 +280,32 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
     return st
 
 
-def _pixel_grid(fr: _Frame, row0: int, row1: int) -> tuple[grids.PixelLayout | None, np.ndarray | None]:
-    """For a camera whose directions are (x[col], y[row], z), z finite and not zero: each
-    column's u = x/z and each row's v = y/z (their lines' coordinates on face 2) as a pixel
-    layout, and the face boxes; (None, None) for other cameras, or where u or v is not
-    finite and monotonic."""
+def _extent(fr: _Frame, row0: int, row1: int) -> tuple[float, float] | None:
+    """The shortest and longest primary direction of rows row0..row1 for a camera whose
+    directions are (x[col], y[row], z), all finite and z not zero; None for other cameras
+    (their directions are measured as the kernels compute them)."""
     z = float(fr.cam[native.CAM_Z])
-    if fr.rotated or not (z != 0 and np.isfinite(z)):
-        return None, None
     xs, ys = fr.xs.astype(np.float64), fr.ys[row0:row1].astype(np.float64)
-    with np.errstate(all="ignore"):
-        pixels = grids.PixelLayout.of(xs / z, ys / z)
-    if pixels is None:
-        return None, None
-    boxes = grids.EMPTY_BOXES.copy()
-    shortest = np.sqrt(np.min(xs**2) + np.min(ys**2) + z * z)
-    longest = np.sqrt(np.max(xs**2) + np.max(ys**2) + z * z)
-    boxes[2] = (pixels.u.min(), pixels.u.max(), pixels.v.min(), pixels.v.max(), len(xs) * len(ys), shortest, longest)
-    return pixels, boxes
+    if fr.rotated or not (z != 0 and np.isfinite(z) and np.isfinite(xs).all() and np.isfinite(ys).all()):
+        return None
+    return (float(np.sqrt(np.min(xs**2) + np.min(ys**2) + z * z)),
+            float(np.sqrt(np.max(xs**2) + np.max(ys**2) + z * z)))
 
 
-def _primary_grid(fr: _Frame, boxes: np.ndarray,
-                  pixels: grids.PixelLayout | None) -> tuple[grids.Grid, np.ndarray, np.ndarray]:
-    """The primary rays' grid, and per shape its depth floor and cull data."""
-    used = boxes[:, 4] > 0
-    dmin = float(boxes[used, 5].min()) if used.any() else 0.0
-    dmax = float(boxes[used, 6].max()) if used.any() else 0.0
+def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The hierarchy's boxes for the primary rays (directions dmin..dmax long), and per
+    shape its depth floor and cull data."""
     apex = fr.cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)
     bounded = fr.bounded & bool(np.isfinite(apex).all())
     with np.errstate(all="ignore"):  # a camera at infinity: nothing is bounded
-        centers = fr.bnd[:, :3] - apex
-        dist = np.linalg.norm(centers, axis=1)
+        dist = np.linalg.norm(fr.bnd[:, :3] - apex, axis=1)
     u, tiny = fr.ar.unit_roundoff, fr.ar.tiny
     radius = bounds.cull_radii(fr.bnd, bounded, dist, dmin, u, tiny, fr.fp16, fr.jobs)
     floor = bounds.depth_floors(fr.bnd, bounded, dist, dmin, dmax, u, tiny, fr.jobs)
     pc = np.empty((len(radius), native.PC_COLUMNS))
     native.library().bound_primary(fr.bnd.ctypes.data, radius.ctypes.data, len(radius), apex.ctypes.data, dmin, u,
                                    tiny, pc.ctypes.data)
-    order = np.argsort(floor, kind="stable").astype(np.int32)
-    return grids.build(boxes, False, centers, radius, order, pixels, reach=True, jobs=fr.jobs), floor, pc
-
-
-#: shadow_origins' output: bounding box of the points, largest magnitude, largest chord,
-#: then the face boxes.
-_ORIGINS = np.concatenate([[np.inf] * 3 + [-np.inf] * 3 + [0.0, 0.0], grids.EMPTY_BOXES.ravel()])
+    return fr.tree.refit(fr.bnd, radius, floor), floor, pc
 
 
 def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.ndarray, acc: np.ndarray,
@@ -352,11 +321,11 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
                           (*[((colour >> shift) & top) / top for shift, top in _CHANNELS],))
     lp.fixed, lp.shadows, lp.parallel, lp.acc = int(options.intensity_fixed), int(shadows), int(not point), acc.ctypes.data
     lp.first = int(k == 0)
-    if shadows:  # lp points into the shadow grid's arrays: they live until the pass is done
-        sg = _shadow_grid(fr, lp, light, hits, n_pix)
-        lp.grid, lp.radius, lp.along = sg.grid.struct(), sg.radius.ctypes.data, sg.along.ctypes.data
-        if sg.behind is not None:
-            lp.behind, lp.reach = sg.behind.ctypes.data, sg.reach.ctypes.data
+    if shadows:  # lp points into the arrays of sb: they live until the pass is done
+        sb = _shadow_bounds(fr, lp, light, hits, n_pix)
+        lp.tree, lp.radius, lp.along = fr.tree.struct(sb.box), sb.radius.ctypes.data, sb.along.ctypes.data
+        if sb.behind is not None:
+            lp.behind, lp.keys = sb.behind.ctypes.data, sb.keys.ctypes.data
             lp.l_len, lp.l_hat[:] = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     c = _report(_run(fr.jobs, n_pix, fr.kernel("light_pass"), lp, _OUT))
     st.shadow_rays += int(c[native.OUT_SHADOW_RAYS])
@@ -367,30 +336,32 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
 
 
 #: shadow_origins' output: bounding box of the points, largest magnitude, largest chord,
-#: then the face boxes.
-_ORIGINS = np.concatenate([[np.inf] * 3 + [-np.inf] * 3 + [0.0, 0.0], grids.EMPTY_BOXES.ravel()])
+#: points with a finite non-zero l, shortest |l|.
+_ORIGINS = np.array([np.inf] * 3 + [-np.inf] * 3 + [0.0, 0.0, 0.0, np.inf])
 
 
 @dataclass
-class _ShadowGrid:
-    """A light's shadow-ray grid over one band, and the per-shape arrays the light pass
-    reads with it (csrc/kernels.h LightPass)."""
+class _ShadowBounds:
+    """A light's shadow rays over one band: the per-shape arrays the light pass reads
+    (csrc/kernels.h LightPass) and the hierarchy's boxes for these rays."""
 
-    grid: grids.Grid
     radius: np.ndarray  # cull radius per shape
+    box: np.ndarray  # node boxes (bvh.Tree.refit)
     along: np.ndarray  # a directional light's l in normal space and a2, per shape
     behind: np.ndarray | None = None  # a directional light's behind terms per shape
-    reach: np.ndarray | None = None  # ... and at every fourth entry, what the rest of the list reaches
+    keys: np.ndarray | None = None  # ... and per node the largest stop keys below it
 
 
-def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.ndarray, n_pix: int) -> _ShadowGrid:
-    """The grid of a light's shadow rays from the band's hit points (``lp`` gets its
-    frame). A directional light's lists run from the shape reaching farthest towards the
-    light, so a packet stops once the rest lies behind its origins."""
+def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.ndarray,
+                   n_pix: int) -> _ShadowBounds:
+    """Cull radii and node boxes for a light's shadow rays from the band's hit points; a
+    directional light's also get the behind terms and stop keys, so a packet skips whole
+    subtrees lying behind its origins."""
     n = len(fr.sf)
     centers = fr.bnd[:, :3]
     along = np.zeros((0, 4), fr.dtype)
-    unbounded = _ShadowGrid(grids.EMPTY, np.full(n, np.inf), along)  # every ray tests every shape
+    none = np.full(n, np.inf)
+    unbounded = _ShadowBounds(none, fr.tree.refit(fr.bnd, none), along)  # every ray tests every shape
     if not hits[native.OUT_HITS]:
         return unbounded
     lo, hi = hits[native.OUT_LO:native.OUT_LO + 3], hits[native.OUT_HI:native.OUT_HI + 3]
@@ -400,58 +371,36 @@ def _shadow_grid(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.n
         mid, half = (lo + hi) / 2, np.sqrt(((hi - lo) ** 2).sum()) / 2
         far = np.sqrt(((centers - mid) ** 2).sum(axis=1)) * (1 + bounds.SLACK) + half  # to any origin, at most
         slack = 1e-12 * (np.sqrt((centers**2).sum(axis=1)) + magnitude)
-    if not lp.parallel:  # a point light: lines through the light, up to the rounding of l
+    if not lp.parallel:  # a point light: the rounding of l turns each ray off the line to the light
         apex = light[native.LT_LOC:native.LT_LOC + 3].astype(np.float64)
-        lp.frame[:3] = apex
         origins = _report_origins(_run(fr.jobs, n_pix, fr.kernel("shadow_origins"), lp, _ORIGINS))
-        boxes, chord = origins[8:].reshape(3, native.BOX_COLUMNS), origins[7]
-        if not boxes[:, 4].any():
+        if not origins[8]:
             return unbounded
         bounded = fr.bounded & bool(np.isfinite(apex).all())
-        radius = bounds.cull_radii(fr.bnd, bounded, far, float(boxes[:, 5].min()), u, tiny, fr.fp16, fr.jobs)
-        radius += far * (chord * (1 + bounds.SLACK) + 1e-15) + slack
-        return _ShadowGrid(grids.build(boxes, False, centers - apex, radius, np.arange(n, dtype=np.int32)), radius,
-                           along)
-    l = light[native.LT_DIR:native.LT_DIR + 3].astype(np.float64)
-    length = float(np.sqrt((l * l).sum())) if np.isfinite(l).all() else 0.0
+        radius = bounds.cull_radii(fr.bnd, bounded, far, float(origins[9]), u, tiny, fr.fp16, fr.jobs)
+        radius += far * (origins[7] * (1 + bounds.SLACK) + 1e-15) + slack
+        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius), along)
+    length, _ = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
         return unbounded
-    axes = _normal_plane(l / length)
-    lp.frame[:] = axes.ravel()
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    uv = _project(corners, axes)  # the points' projections lie in the box of the corners' (widened for rounding)
-    low, high = uv.min(axis=0), uv.max(axis=0)
-    pad = 1e-9 * (np.abs(uv).max() + magnitude)
-    boxes = grids.EMPTY_BOXES.copy()
-    boxes[0, :5] = low[0] - pad, high[0] + pad, low[1] - pad, high[1] + pad, hits[native.OUT_HITS]
     radius = bounds.cull_radii(fr.bnd, fr.bounded, far, length, u, tiny, fr.fp16, fr.jobs) + slack
-    flat = np.zeros((n, 3))
-    with np.errstate(all="ignore"):  # unbounded shapes (infinite centres) have an infinite radius
-        flat[:, :2] = _project(centers, axes)
     along = np.empty((n, 4), fr.dtype)
     fr.kernel("shadow_directions")(byref(fr.shapes), light.ctypes.data, along.ctypes.data)
     behind = _behind_terms(fr, radius, light)
-    with np.errstate(all="ignore"):  # towards the light first; shapes without a behind test before all
-        ahead = behind[:, 0] + np.maximum(radius, (behind[:, 2] * radius + 0.015625 / length)
-                                          / (behind[:, 1] - behind[:, 2]))
-    order = np.argsort(-np.nan_to_num(ahead, nan=np.inf), kind="stable").astype(np.int32)
-    grid = grids.build(boxes, True, flat, radius, order, rays_per_cell=32, jobs=fr.jobs)
-    reach = np.empty((-(-len(grid.entries) // 4), 3))  # at every fourth entry
-    su, sv = grid.faces[0, native.GF_SU], grid.faces[0, native.GF_SV]
-    diag = float(np.hypot(1 / su, 1 / sv)) if su > 0 and sv > 0 else np.inf  # a cell's diagonal
     lib, keys = native.library(), np.empty((n, 3))
-    lib.behind_keys(behind.ctypes.data, radius.ctypes.data, n, diag, length, keys.ctypes.data)
-    threads.split(fr.jobs, threads.balanced(grid.start + np.arange(grid.cells + 1), fr.jobs, grids.CELL_CHUNK),
-                  lambda a, b: lib.behind_reach(grid.start.ctypes.data, a, b, grid.entries.ctypes.data,
-                                                keys.ctypes.data, reach.ctypes.data))
-    return _ShadowGrid(grid, radius, along, behind, reach)
+    lib.behind_keys(behind.ctypes.data, radius.ctypes.data, n, length, keys.ctypes.data)
+    box = fr.tree.refit(fr.bnd, radius)
+    node_keys = np.empty((fr.tree.nodes, 3))
+    lib.bvh_keys(fr.tree.struct(box), keys.ctypes.data, node_keys.ctypes.data)
+    return _ShadowBounds(radius, box, along, behind, node_keys)
 
 
 def _unit(v: np.ndarray) -> tuple[float, np.ndarray]:
-    """(|v|, v/|v|) in float64."""
+    """(|v|, v/|v|) in float64 (|v| is 0 or not finite where v/|v| means nothing)."""
     v = v.astype(np.float64)
-    length = float(np.sqrt((v * v).sum()))
-    return length, v / length
+    with np.errstate(all="ignore"):
+        length = float(np.sqrt((v * v).sum()))
+        return length, v / length
 
 
 def _behind_terms(fr: _Frame, radius: np.ndarray, light: np.ndarray) -> np.ndarray:
@@ -469,21 +418,8 @@ def _behind_terms(fr: _Frame, radius: np.ndarray, light: np.ndarray) -> np.ndarr
 
 
 def _report_origins(outs: np.ndarray) -> np.ndarray:
-    """shadow_origins' chunks merged: boxes joined, the largest chord kept."""
+    """shadow_origins' chunks merged: boxes joined, counts summed, extremes kept."""
     out = _ORIGINS.copy()
     out[:3], out[3:6], out[6:8] = outs[:, :3].min(axis=0), outs[:, 3:6].max(axis=0), outs[:, 6:8].max(axis=0)
-    out[8:] = grids.merge_boxes(outs[:, 8:].reshape(len(outs), 3, native.BOX_COLUMNS)).ravel()
+    out[8], out[9] = outs[:, 8].sum(), outs[:, 9].min()
     return out
-
-
-def _project(points: np.ndarray, axes: np.ndarray) -> np.ndarray:
-    """Points (n, 3) projected on axes (k, 3): (n, k), element-wise (BLAS would start
-    its own spinning threads for a product this small)."""
-    return np.stack([points[:, 0] * a[0] + points[:, 1] * a[1] + points[:, 2] * a[2] for a in axes], axis=1)
-
-
-def _normal_plane(d: np.ndarray) -> np.ndarray:
-    """Two orthonormal vectors (2, 3) normal to the unit vector d."""
-    e1 = np.cross(d, [1.0, 0.0, 0.0] if abs(d[0]) < 0.9 else [0.0, 1.0, 0.0])
-    e1 /= np.linalg.norm(e1)
-    return np.stack([e1, np.cross(d, e1)])

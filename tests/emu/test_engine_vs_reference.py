@@ -4,7 +4,7 @@ shape, numpy): identical pixels, depth bits and provenance on random scenes.
 Scenes mix every shape type (and types that are off), rotations, scales, both cameras,
 directional and point lights, every precision (and other formats eEmM) with flushed and gradual underflow, the
 original board's profile, exact ties (duplicated shapes), and float16 operands that are
-infinite, NaN, subnormal, zero of either sign or the largest finite value. About 600
+infinite, NaN, subnormal, zero of either sign or the largest finite value. About 850
 scenes run in CI (fixed seed); ``benchmarks/fuzz_engine.py`` runs more.
 """
 
@@ -193,8 +193,8 @@ def test_random_scenes_on_the_original_board(cam, lights, shapes, ties, prec, ie
 @given(st.integers(1, 6), st.integers(1, 4), st.floats(0.02, 0.12), st.floats(2, 12), st.lists(light, min_size=1, max_size=2),
        quaternion(0), precision)
 def test_random_walls(g, k, size, distance, lights, rot, prec):
-    """Many spheres in view, in front of each other: grids with several shapes per cell,
-    depth order, shadows cast by neighbours."""
+    """Many spheres in view, in front of each other: deep hierarchies, depth order,
+    shadows cast by neighbours."""
     cam = {"xloc": 0, "yloc": 0, "zloc": 0, "rot": (0, 0, 0, 0), "hfov": float_to_bits(0.4),
            "vfov": float_to_bits(0.4), "nclip": 0, "fclip": 0}
     shapes = [{"type": 1, "col": 0x1234 * (i + 1) & 0xFFFF, "rot": rot, "stretch": (1.0, 1.0, 1.0), "special": None,
@@ -202,6 +202,16 @@ def test_random_walls(g, k, size, distance, lights, rot, prec):
                        distance * (1 + 0.15 * (i // (g * g))), size)} for i in range(g * g * k)]
     options = EmuOptions(precision=prec[0], subnormals=prec[1], width=24, height=18)
     check(program(cam, lights, shapes, [], options), options)
+
+
+@settings(max_examples=60, derandomize=True)
+@given(camera, st.lists(light, max_size=3), st.lists(shape, min_size=12, max_size=60),
+       st.lists(st.integers(0, 11), max_size=3), precision)
+def test_random_crowds(cam, lights, shapes, ties, prec):
+    """Enough shapes of every kind for a hierarchy several levels deep: inner nodes, leaves
+    and the list of shapes outside the tree, for primary and shadow rays."""
+    options = EmuOptions(precision=prec[0], subnormals=prec[1], width=24, height=18)
+    check(program(cam, lights, shapes, ties, options), options)
 
 
 def test_value_types_are_what_the_tables_say():

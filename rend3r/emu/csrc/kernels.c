@@ -5,7 +5,7 @@
  * The datapath is written once (datapath.inc) and instantiated per working precision
  * and instruction set in instances/: _f32 (fp32), _h16 (fp16, subnormals flushed), _h16i
  * (fp16, IEEE subnormals), _f64 (fp64), each _base and _avx2. This file holds the rest:
- * grid building and bounds, in double.
+ * the shape hierarchy, shadow grids and bounds, in double.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -14,9 +14,9 @@
 #include <stdint.h>
 
 #include "bounds.h"
+#include "bvh.h"
 #include "colour.h"
 #include "fround.h"
-#include "grids.h"
 #include "kernels.h"
 #include "simd.h"
 #include "cull.h"
@@ -33,244 +33,126 @@ int32_t have_avx2(void)
 #endif
 }
 
-/* ---- grids (rend3r/emu/grids.py) ---- */
+/* ---- the shape hierarchy (rend3r/emu/bvh.py, csrc/bvh.h) ---- */
 
-/* Range of a/c over a in [x - r, x + r], c in [z - r, z + r] (0 not in the latter):
- * extreme at the corners. */
-static void ratio_range(double x, double z, double r, double *lo, double *hi)
+/* Reorders items[lo..hi) so that items[k] has the centre coordinate `axis` that sorting
+ * would give it, none before it larger and none after it smaller (quickselect). */
+static void select_nth(const double *bnd, int32_t *items, int64_t lo, int64_t hi, int64_t k, int axis)
 {
-    double a[2] = {x - r, x + r}, c[2] = {z - r, z + r};
-    *lo = INFINITY;
-    *hi = -INFINITY;
-    for (int i = 0; i < 2; i++)
-        for (int j = 0; j < 2; j++) {
-            double q = a[i] / c[j];
-            *lo = fmin(*lo, q);
-            *hi = fmax(*hi, q);
-        }
-}
-
-/* The first index of ascending a[0..n) whose value is >= x (after = 0) or > x (after = 1). */
-static int64_t search(const double *a, int64_t n, double x, int after)
-{
-    int64_t lo = 0, hi = n;
-    while (lo < hi) {
-        int64_t mid = lo + (hi - lo) / 2;
-        if (after ? a[mid] <= x : a[mid] < x)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
-/* The cells of a pixel grid whose rays' (u, v) lie in [ulo, uhi] x [vlo, vhi]. */
-static int pixel_footprint(const Grid *g, double ulo, double uhi, double vlo, double vhi, int64_t *out)
-{
-    double a0 = g->u_sign > 0 ? ulo : -uhi, a1 = g->u_sign > 0 ? uhi : -ulo;
-    double b0 = g->v_sign > 0 ? vlo : -vhi, b1 = g->v_sign > 0 ? vhi : -vlo;
-    int64_t c0 = search(g->u_at, g->n_u, a0, 0), c1 = search(g->u_at, g->n_u, a1, 1) - 1;
-    int64_t r0 = search(g->v_at, g->n_v, b0, 0), r1 = search(g->v_at, g->n_v, b1, 1) - 1;
-    if (c0 > c1 || r0 > r1)
-        return 0;
-    out[0] = c0 / g->block; out[1] = c1 / g->block; out[2] = r0 / g->block_rows; out[3] = r1 / g->block_rows;
-    return 1;
-}
-
-/* The cell rectangle a ball (centre c relative to the apex, or projected (u, v) for a
- * parallel grid; radius r) covers on a face: 0 when it covers none. Lines through the
- * ball have (u, v) in the ratio box of its bounding cube, widened for float64 rounding. */
-static int footprint(const Grid *g, int parallel, int face, const double *c, double r, int64_t *out)
-{
-    const double *f = g->faces + GF_COLUMNS * face;
-    const int64_t *s = g->shape + GS_COLUMNS * face;
-    double ulo, uhi, vlo, vhi;
-    if (s[GS_NU] == 0)
-        return 0;
-    if (parallel) {
-        ulo = c[0] - r; uhi = c[0] + r; vlo = c[1] - r; vhi = c[1] + r;
-    } else {
-        double x = face == 0 ? c[1] : c[0], y = face == 2 ? c[1] : c[2], z = c[face];
-        if (z - r <= 0.0 && 0.0 <= z + r) {  /* the ball meets the plane through the apex */
-            ulo = f[GF_U0]; uhi = f[GF_U1]; vlo = f[GF_V0]; vhi = f[GF_V1];
-        } else {
-            ratio_range(x, z, r, &ulo, &uhi);
-            ratio_range(y, z, r, &vlo, &vhi);
-        }
-    }
-    ulo -= UV_SLACK * (1.0 + fabs(ulo)); vlo -= UV_SLACK * (1.0 + fabs(vlo));
-    uhi += UV_SLACK * (1.0 + fabs(uhi)); vhi += UV_SLACK * (1.0 + fabs(vhi));
-    if (face == 2 && g->u_at != NULL)
-        return pixel_footprint(g, ulo, uhi, vlo, vhi, out);
-    if (!(ulo <= f[GF_U1] && uhi >= f[GF_U0] && vlo <= f[GF_V1] && vhi >= f[GF_V0]))
-        return 0;
-    out[0] = (int64_t)((fmax(ulo, f[GF_U0]) - f[GF_U0]) * f[GF_SU]);
-    out[1] = (int64_t)((fmin(uhi, f[GF_U1]) - f[GF_U0]) * f[GF_SU]);
-    out[2] = (int64_t)((fmax(vlo, f[GF_V0]) - f[GF_V0]) * f[GF_SV]);
-    out[3] = (int64_t)((fmin(vhi, f[GF_V1]) - f[GF_V0]) * f[GF_SV]);
-    if (out[1] > s[GS_NU] - 1) out[1] = s[GS_NU] - 1;
-    if (out[3] > s[GS_NV] - 1) out[3] = s[GS_NV] - 1;
-    if (out[0] > out[1]) out[0] = out[1];
-    if (out[2] > out[3]) out[2] = out[3];
-    return 1;
-}
-
-/* Per shape and face, the cell rectangle its footprint covers (out: n x 3 x 4: iu0, iu1,
- * iv0, iv1; iu0 > iu1 where none, iu0 = -1 for a shape without a finite radius). */
-void grid_footprints(const Grid *g, int32_t parallel, const double *centers, const double *radii, int64_t n,
-                     int64_t *out)
-{
-    for (int64_t s = 0; s < n; s++) {
-        for (int face = 0; face < 3; face++) {
-            int64_t *box = out + 12 * s + 4 * face;
-            if (!(radii[s] < INFINITY)) {
-                box[0] = -1; box[1] = -2; box[2] = box[3] = 0;
-            } else if ((parallel && face > 0) || !footprint(g, parallel, face, centers + 3 * s, radii[s], box)) {
-                box[0] = 1; box[1] = box[2] = box[3] = 0;
+#define KEY(i) bnd[B_COLUMNS * (int64_t)items[i] + axis]
+    while (hi - lo > 1) {
+        double pivot = KEY(lo + (hi - lo) / 2);
+        int64_t i = lo, j = hi - 1;
+        while (i <= j) {
+            while (KEY(i) < pivot) i++;
+            while (KEY(j) > pivot) j--;
+            if (i <= j) {
+                int32_t t = items[i]; items[i] = items[j]; items[j] = t;
+                i++; j--;
             }
         }
+        if (k <= j) hi = j + 1;
+        else if (k >= i) lo = i;
+        else return;
     }
+#undef KEY
 }
 
-/* Count (fill == 0) or write (fill == 1; pos: each cell's next free entry) the listed
- * shapes of order into the cells of their rectangles (rects as grid_footprints gives
- * them; shape: per face cells along u, along v, first cell). */
-void grid_fill(const int64_t *rects, const int64_t *shape, const int32_t *order, int64_t n, const uint8_t *listed,
-               int64_t *pos, int32_t *entries, int32_t fill)
+/* The hierarchy over the n shapes items (slots into bnd, whose centres are finite):
+ * median splits of each node's shapes across the longest side of their centres' box,
+ * leaves of at most BVH_LEAF. items is reordered leaf by leaf; node (2 ints per node, room
+ * for 2n nodes) gets the nodes depth first. Returns the node count. */
+int64_t bvh_build(const double *bnd, int32_t *items, int64_t n, int32_t *node)
 {
-    for (int64_t k = 0; k < n; k++) {
-        int32_t s = order[k];
-        if (!listed[s])
+    int64_t stack[4 * BVH_STACK], top = 1, count = 0;
+    if (n <= 0)
+        return 0;
+    /* pending ranges: lo, hi, the parent whose right child it is (-1: none), depth */
+    stack[0] = 0; stack[1] = n; stack[2] = -1; stack[3] = 0;
+    while (top > 0) {
+        top--;
+        int64_t lo = stack[4 * top], hi = stack[4 * top + 1], parent = stack[4 * top + 2], depth = stack[4 * top + 3];
+        int64_t at = count++;
+        if (parent >= 0)
+            node[2 * parent] = (int32_t)at;
+        if (hi - lo <= BVH_LEAF || depth + 2 >= BVH_STACK) {  /* traversal stacks hold depth + 2 nodes */
+            node[2 * at] = (int32_t)lo;
+            node[2 * at + 1] = (int32_t)(hi - lo);
             continue;
-        for (int face = 0; face < 3; face++) {
-            const int64_t *box = rects + 12 * (int64_t)s + 4 * face;
-            const int64_t *gs = shape + GS_COLUMNS * face;
-            for (int64_t iv = box[2]; iv <= box[3] && box[0] <= box[1]; iv++) {
-                int64_t row = gs[GS_FIRST] + iv * gs[GS_NU];
-                for (int64_t iu = box[0]; iu <= box[1]; iu++) {
-                    if (fill)
-                        entries[pos[row + iu]] = s;
-                    pos[row + iu]++;
-                }
+        }
+        double bl[3] = {INFINITY, INFINITY, INFINITY}, bh[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int64_t i = lo; i < hi; i++) {
+            const double *c = bnd + B_COLUMNS * (int64_t)items[i];
+            for (int k = 0; k < 3; k++) { bl[k] = MIN(bl[k], c[k]); bh[k] = MAX(bh[k], c[k]); }
+        }
+        int axis = 0;
+        for (int k = 1; k < 3; k++)
+            if (bh[k] - bl[k] > bh[axis] - bl[axis])
+                axis = k;
+        int64_t mid = lo + (hi - lo) / 2;
+        select_nth(bnd, items, lo, hi, mid, axis);
+        node[2 * at + 1] = 0;
+        int64_t right[4] = {mid, hi, at, depth + 1}, left[4] = {lo, mid, -1, depth + 1};
+        memcpy(stack + 4 * top++, right, sizeof right);  /* after the left subtree */
+        memcpy(stack + 4 * top++, left, sizeof left);    /* the next node */
+    }
+    return count;
+}
+
+/* One bundle's node boxes (t->nodes x BV_COLUMNS into box): each node's box holds the
+ * balls (centre, radius) of its shapes, padded outwards by 1e-9 of the radius and 1e-12
+ * of the centre's size (an infinite or NaN radius: an infinite box), and the least of
+ * their floors (NULL: -inf). Children follow their parent, so nodes go last to first. */
+void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const double *floor, double *box)
+{
+    for (int64_t at = t->nodes - 1; at >= 0; at--) {
+        double *b = box + BV_COLUMNS * at;
+        int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
+        for (int k = 0; k < 3; k++) { b[BV_LO + k] = INFINITY; b[BV_HI + k] = -INFINITY; }
+        b[BV_FLOOR] = INFINITY;
+        if (count == 0) {
+            const double *l = box + BV_COLUMNS * (at + 1), *r = box + BV_COLUMNS * (int64_t)first;
+            for (int k = 0; k < 3; k++) {
+                b[BV_LO + k] = MIN(l[BV_LO + k], r[BV_LO + k]);
+                b[BV_HI + k] = MAX(l[BV_HI + k], r[BV_HI + k]);
             }
+            b[BV_FLOOR] = MIN(l[BV_FLOOR], r[BV_FLOOR]);
+            continue;
+        }
+        for (int32_t i = first; i < first + count; i++) {
+            int64_t s = t->items[i];
+            const double *c = bnd + B_COLUMNS * s;
+            double r = radius[s];
+            r = r < INFINITY ? r * (1.0 + 1e-9) + 1e-12 * (fabs(c[0]) + fabs(c[1]) + fabs(c[2])) : INFINITY;
+            for (int k = 0; k < 3; k++) {
+                b[BV_LO + k] = MIN(b[BV_LO + k], c[k] - r);
+                b[BV_HI + k] = MAX(b[BV_HI + k], c[k] + r);
+            }
+            b[BV_FLOOR] = MIN(b[BV_FLOOR], floor != NULL ? floor[s] : -INFINITY);
         }
     }
 }
 
-#define HALF_PI 1.5707963267948966  /* M_PI_2 is not C11 */
-
-/* The double cone (unit axis a, half-angle t; t >= pi/2: every line) around the apex
- * holding cones 1 and 2 (lines: a2 flipped into a1's hemisphere). */
-static void cone_union(double *a1, double *t1, const double *a2_, double t2)
-{
-    double a2[3] = {a2_[0], a2_[1], a2_[2]}, dot = a1[0] * a2[0] + a1[1] * a2[1] + a1[2] * a2[2];
-    if (dot < 0) {
-        a2[0] = -a2[0]; a2[1] = -a2[1]; a2[2] = -a2[2]; dot = -dot;
-    }
-    double w[3] = {a2[0] - dot * a1[0], a2[1] - dot * a1[1], a2[2] - dot * a1[2]};
-    double sine = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), phi = atan2(sine, dot) * (1.0 + 1e-12) + 1e-15;
-    if (*t1 >= HALF_PI || phi + t2 <= *t1)
-        return;
-    if (t2 >= HALF_PI || phi + *t1 <= t2 || !(sine > 1e-9)) {
-        double keep = t2 >= *t1 ? t2 : *t1;
-        if (t2 >= *t1)
-            memcpy(a1, a2, sizeof a2);
-        *t1 = sine > 1e-9 ? t2 : keep + phi;
-        return;
-    }
-    double t = (phi + *t1 + t2) / 2, turn = t - *t1;
-    for (int c = 0; c < 3; c++)
-        a1[c] = cos(turn) * a1[c] + sin(turn) * w[c] / sine;
-    double len = sqrt(a1[0] * a1[0] + a1[1] * a1[1] + a1[2] * a1[2]);
-    for (int c = 0; c < 3; c++)
-        a1[c] /= len;
-    *t1 = t * (1.0 + 1e-12) + 1e-12;
-}
-
-/* Per shape, what cone_reach needs of its ball seen from the apex (CONE_COLUMNS doubles):
- * the unit axis, the half-angle t (pi/2: every line), and sin t, cos t for the
- * containment test; centres relative to the apex, cull radii. */
-void cone_balls(const double *centers, const double *radii, int64_t n, double *out)
-{
-    for (int64_t s = 0; s < n; s++) {
-        const double *c = centers + 3 * s;
-        double r = radii[s], dist = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), *o = out + CONE_COLUMNS * s;
-        int ball = dist > r && r < INFINITY && dist < INFINITY;
-        double sr = r / dist;
-        o[0] = c[0] / dist; o[1] = c[1] / dist; o[2] = c[2] / dist;
-        o[3] = ball ? asin(sr) * (1.0 + 1e-12) + 1e-12 : HALF_PI;
-        o[4] = sr;
-        o[5] = sqrt(fmax(0.0, 1.0 - sr * sr));
-    }
-}
-
-/* A perspective grid's reach (Grid.reach) for cells k0..k1: for each cell, backwards over
- * its list, the union of the lines' cones of the entry's ball (cone_balls) and every
- * later one, written at entries that are multiples of 4. The stored cone is widened by
- * 1e-6 rad for the float axis (its error is below 1e-7 rad) and its cosine rounded down. */
-void cone_reach(const double *balls, const int64_t *start, int64_t k0, int64_t k1, const int32_t *entries,
-                float *out)
-{
-    for (int64_t k = k0; k < k1; k++) {
-        double axis[3] = {0, 0, 1}, angle = -1.0, cos_a = 1.0, written = -2.0;
-        float stored[4] = {0};
-        for (int64_t i = start[k + 1] - 1; i >= start[k]; i--) {
-            const double *ball = balls + CONE_COLUMNS * (int64_t)entries[i], *a = ball, t = ball[3];
-            int inside = 0;
-            if (angle >= 0 && angle < HALF_PI && t < HALF_PI) {
-                /* the ball inside the cone without trigonometry: the angle between the axis and
-                 * the centre plus the ball's half-angle at most the cone's, with room for rounding */
-                double dot = fabs(axis[0] * a[0] + axis[1] * a[1] + axis[2] * a[2]);
-                double sine = sqrt(fmax(0.0, 1.0 - dot * dot));
-                inside = dot * ball[5] - sine * ball[4] >= cos_a + 1e-9;  /* cos(angle to axis + half-angle) */
-            }
-            if (!inside) {
-                double before = angle, was[3] = {axis[0], axis[1], axis[2]};
-                if (angle < 0) {
-                    memcpy(axis, a, sizeof axis);
-                    angle = t;
-                } else {
-                    cone_union(axis, &angle, a, t);
-                }
-                if (angle != before)
-                    cos_a = cos(angle);
-                if (memcmp(was, axis, sizeof was) != 0)
-                    written = -2.0;  /* the axis turned */
-            }
-            if (i % 4 == 0) {
-                if (written != angle) {  /* else the same cone as the last one written */
-                    int every = !(angle + 1e-6 < HALF_PI) || !(axis[0] == axis[0]);
-                    for (int q = 0; q < 3; q++)
-                        stored[q] = every ? 0.0f : (float)axis[q];
-                    float cs = (float)cos(angle + 1e-6);
-                    stored[3] = every ? -2.0f : ((double)cs > cos(angle + 1e-6) ? nextafterf(cs, -INFINITY) : cs);
-                    written = angle;
-                }
-                memcpy(out + i, stored, sizeof stored);
-            }
-        }
-    }
-}
-
-/* A directional light's stop keys per shape (BEHIND_COLUMNS; LightPass.reach), from the
- * behind terms and cull radii; diag: a cell's diagonal, l_len: |l|.
+/* A directional light's stop keys per shape (3 doubles: K0, K1, K2), from its behind
+ * terms and cull radius; l_len: |l|.
  *
  * blocked() skips shape c for a packet when ahead = least - bh0 > 0, mid - spread > r and
  * l_len (bh1 ahead - bh2 (mid + spread)) > 1/64, mid being the distance from the packet's
  * centre to c's. The centre lies within spread of every origin, so its depth along l is
- * at least least - spread (mid >= ahead - spread), and c's footprint meets the cell that
- * holds the origins, so the centres lie within r + diag + spread of each other across l
- * (mid <= ahead + 2 spread + r + diag). Hence least >= K2 + 2 spread, K2 = bh0 + r, gives
- * the first two conditions, and least >= K0 + K1 spread, K0 = bh0 + (b2 (r + diag) +
- * 1/(64 l_len)) / (bh1 - b2), K1 = 3 b2 / (bh1 - b2), the third (b2: bh2 widened by 1e-8
- * for the rounding of mid; r likewise). A shape without a test gets infinities. */
-void behind_keys(const double *behind, const double *radius, int64_t n, double diag, double l_len, double *out)
+ * at least least - spread (mid >= ahead - spread), and a shape whose ball some lane's line
+ * meets has its centre within r + spread of the packet's centre across l (mid <= ahead +
+ * 2 spread + r; a shape no line meets is missed whatever the keys say). Hence least >= K2
+ * + 2 spread, K2 = bh0 + r, gives the first two conditions, and least >= K0 + K1 spread,
+ * K0 = bh0 + (b2 r + 1/(64 l_len)) / (bh1 - b2), K1 = 3 b2 / (bh1 - b2), the third (b2:
+ * bh2 widened by 1e-8 for the rounding of mid; r likewise). A shape without a test gets
+ * infinities. */
+void behind_keys(const double *behind, const double *radius, int64_t n, double l_len, double *out)
 {
     for (int64_t s = 0; s < n; s++) {
         const double *bh = behind + 3 * s;
         double r = radius[s] * (1.0 + 1e-8), b2 = bh[2] * (1.0 + 1e-8), a = bh[1] - b2;
-        double pad = 1e-12 * (fabs(bh[0]) + r + diag);
-        double key[3] = {bh[0] + (b2 * (r + diag) + 0.015625 / l_len) / a + pad, 3.0 * b2 / a, bh[0] + r + pad};
+        double pad = 1e-12 * (fabs(bh[0]) + r);
+        double key[3] = {bh[0] + (b2 * r + 0.015625 / l_len) / a + pad, 3.0 * b2 / a, bh[0] + r + pad};
         int ok = bh[0] == bh[0] && a > 0 && r < INFINITY;
         for (int c = 0; c < 3; c++)
             ok &= key[c] == key[c] && key[c] < INFINITY;
@@ -279,21 +161,24 @@ void behind_keys(const double *behind, const double *radius, int64_t n, double d
     }
 }
 
-/* The reach of cells k0..k1 of a directional light's shadow grid at entries i that are
- * multiples of 4 (out + 3 (i / 4)): per key, the largest over the entry and every later
- * one of its list (behind_keys). */
-void behind_reach(const int64_t *start, int64_t k0, int64_t k1, const int32_t *entries, const double *keys,
-                  double *out)
+/* Per node of t, the largest of each of its shapes' stop keys (behind_keys; out: 3 per
+ * node): a packet for which the keys' test holds has every shape below it behind every
+ * origin (K1 multiplies spread >= 0, so the test only gets harder as keys grow). */
+void bvh_keys(const Bvh *t, const double *keys, double *out)
 {
-    for (int64_t k = k0; k < k1; k++) {
-        double m[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (int64_t i = start[k + 1] - 1; i >= start[k]; i--) {
-            const double *key = keys + 3 * (int64_t)entries[i];
+    for (int64_t at = t->nodes - 1; at >= 0; at--) {
+        double *o = out + 3 * at;
+        int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
+        for (int c = 0; c < 3; c++)
+            o[c] = -INFINITY;
+        if (count == 0) {
             for (int c = 0; c < 3; c++)
-                m[c] = MAX(m[c], key[c]);
-            if (i % 4 == 0)
-                memcpy(out + 3 * (i / 4), m, sizeof m);
+                o[c] = MAX(out[3 * (at + 1) + c], out[3 * (int64_t)first + c]);
+            continue;
         }
+        for (int32_t i = first; i < first + count; i++)
+            for (int c = 0; c < 3; c++)
+                o[c] = MAX(o[c], keys[3 * (int64_t)t->items[i] + c]);
     }
 }
 
@@ -334,25 +219,6 @@ void bound_primary(const double *bnd, const double *radius, int64_t n, const dou
         pc[PC_BEHIND] = r < INFINITY && dist > r ? ((smax * smax - smin * smin) / 2.0 + 64.0 * uu * smax * smax) * dist
                                                  : NAN;
     }
-}
-
-/* Counting sort: the items (0..n) by their bucket (0..nbuckets; negative: left out), in
- * order within a bucket. start gets nbuckets + 1 entries. */
-void bucket_sort(const int32_t *bucket, int64_t n, int64_t nbuckets, int64_t *start, int32_t *items)
-{
-    for (int64_t k = 0; k <= nbuckets; k++)
-        start[k] = 0;
-    for (int64_t i = 0; i < n; i++)
-        if (bucket[i] >= 0)
-            start[bucket[i] + 1]++;
-    for (int64_t k = 0; k < nbuckets; k++)
-        start[k + 1] += start[k];
-    for (int64_t i = 0; i < n; i++)
-        if (bucket[i] >= 0)
-            items[start[bucket[i]]++] = (int32_t)i;
-    for (int64_t k = nbuckets; k > 0; k--)
-        start[k] = start[k - 1];
-    start[0] = 0;
 }
 
 /* ---- rounding, for tests ---- */

@@ -25,14 +25,6 @@ enum { CAM_ORIGIN = 0, CAM_TMIN = 3, CAM_TMAX = 4, CAM_Z = 5, CAM_ROT = 6, CAM_C
 /* Light table (working type): kind, location, l of a directional light, intensity. */
 enum { LT_KIND = 0, LT_LOC = 1, LT_DIR = 4, LT_INTENSITY = 7, LT_COLUMNS = 8 };
 enum { LIGHT_DIRECTIONAL = 1, LIGHT_POINT = 2 };
-/* Grid face columns (double): the rays' u0, u1, v0, v1, then cells per unit of u, v;
- * face ints: cells along u, along v, first cell. */
-/* cone_balls: unit axis, half-angle, its sine and cosine per shape. */
-enum { CONE_COLUMNS = 6 };
-enum { GF_U0 = 0, GF_U1 = 1, GF_V0 = 2, GF_V1 = 3, GF_SU = 4, GF_SV = 5, GF_COLUMNS = 6 };
-enum { GS_NU = 0, GS_NV = 1, GS_FIRST = 2, GS_COLUMNS = 3 };
-/* Per-face ray statistics: u0, u1, v0, v1, rays, shortest and longest direction. */
-enum { BOX_COLUMNS = 7 };
 /* Primary cull data per shape (double): centre minus camera, its squared length, the
  * squared cull radius with slack, and the two terms of the behind test (bounds.h). */
 enum { PC_V = 0, PC_VV = 3, PC_R2 = 4, PC_MEAN2 = 5, PC_BEHIND = 6, PC_COLUMNS = 7 };
@@ -62,26 +54,19 @@ typedef struct {
     const Format *format;   /* the _fmt kernels' format (NULL for the others) */
 } Shapes;
 
+/* Shape hierarchy node columns (double, per bundle of rays): box corners lo, hi, the least
+ * depth floor below (csrc/bvh.h). */
+enum { BV_LO = 0, BV_HI = 3, BV_FLOOR = 6, BV_COLUMNS = 7 };
+
 typedef struct {
-    const double *faces;    /* 3 x GF_COLUMNS */
-    const int64_t *shape;   /* 3 x GS_COLUMNS */
-    const int64_t *start;   /* cells + 1 */
-    int64_t start_count;    /* cells + 1 */
-    const int32_t *entries; /* shape slots, per cell */
-    const int32_t *glob;    /* shape slots every ray tests */
-    int64_t nglob;
-    /* A grid camera's pixel grid (face 2 only; u_at NULL otherwise): cells are blocks of
-     * `block` columns by `block_rows` rows; u_at holds u_sign * u of every column and v_at
-     * v_sign * v of every row of the band, both ascending. */
-    const double *u_at, *v_at;
-    int64_t n_u, n_v, block, block_rows;
-    double u_sign, v_sign;
-    /* A perspective grid's reach (or NULL), at every fourth entry: a double cone around
-     * the apex (float axis x, y, z and cos of its half-angle, -2 for every line) holding
-     * every line that may hit the entry's shape or a later one of its cell's list
-     * (kernels.c cone_reach); entry i's is at reach + i, i a multiple of 4. */
-    const float *reach;
-} Grid;
+    const int32_t *node;    /* per node: right child (inner) or first item (leaf), item count (0: inner);
+                               an inner node's left child is the next node */
+    const int32_t *items;   /* shape slots, leaf by leaf */
+    const double *box;      /* nodes x BV_COLUMNS, for one bundle of rays (bvh_refit) */
+    int64_t nodes;
+    const int32_t *always;  /* shape slots outside the tree (no finite bound): every ray tests them */
+    int64_t nalways;
+} Bvh;
 
 typedef struct {            /* the primary rays of one band of rows */
     const Shapes *sh;
@@ -94,9 +79,7 @@ typedef struct {            /* the primary rays of one band of rows */
     void *dirs;             /* pixels x 4: direction and |d|^2, working (rotated camera; else NULL) */
     const double *pc;       /* per shape PC_COLUMNS: the primary rays' cull data (bounds.h) */
     const double *floor;    /* depth floor per shape */
-    Grid grid;
-    const int64_t *bucket_start; /* rotated camera: pixels by cell, cells + 2 starts (last: outside) */
-    const int32_t *bucket_pixels;
+    Bvh tree;               /* the shapes, with the primary rays' boxes */
     int32_t *slot;          /* nearest shape, -1 none */
     void *sqd;              /* its sq_dist, working */
     void *pt, *nm;          /* 3 x pixels (x row, y row, z row), working (lit only) */
@@ -110,24 +93,18 @@ typedef struct {            /* one light over one band */
     const Band *band;
     const void *light;      /* LT_COLUMNS, working */
     double scale[3];        /* light channel / channel maximum */
-    double frame[6];        /* parallel: two axes normal to l; point: the location */
     int32_t fixed;          /* the device's 13-bit intensity converter */
     int32_t shadows;        /* cast shadow rays (there are other shapes) */
-    int32_t parallel;       /* directional light: parallel grid, per-shape terms in along */
+    int32_t parallel;       /* directional light: per-shape terms in along */
     int32_t first;          /* the band's first light: it sets the colour sums instead of adding */
     const void *along;      /* n x 4: l in normal space and a2, working (directional) */
     const double *behind;   /* n x 3 (directional): centre . l/|l|, and the behind test's mean2
                                and (spread2 + 64 uu smax^2), NaN where no test applies */
     double l_hat[3], l_len; /* a directional light's l/|l| and |l| */
     const double *radius;   /* cull radius per shape, for these shadow rays */
-    /* At every fourth entry of the grid's lists (directional light; else NULL): K0, K1,
-     * K2, the largest over the entry's shape and every later one of its cell (kernels.c
-     * behind_reach; entry i's at reach + 3 (i / 4)); a packet whose origins lie at depth
-     * >= least along l within spread of their centre skips the rest of the list once
-     * least >= max(K0 + K1 spread, K2 + 2 spread), as every shape left lies behind every
-     * origin. */
-    const double *reach;
-    Grid grid;
+    Bvh tree;               /* the shapes, with these shadow rays' boxes */
+    const double *keys;     /* directional light (else NULL): per node the largest stop keys below it
+                               (kernels.c behind_keys, bvh_keys) */
     double *acc;            /* pixels x 3 colour sums */
 } LightPass;
 

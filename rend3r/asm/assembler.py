@@ -3,7 +3,9 @@
 Lines are read one at a time: the fast path (:mod:`.fastpath`) encodes plain
 instruction lines, everything else goes through the Lark grammar (:mod:`.parser`), and
 instructions are encoded by :mod:`.operands`. Statements run as soon as they are read,
-except inside a ``.rept`` block, whose body is collected and then run once per iteration.
+except inside a ``.rept`` block, whose body is collected and then run once per iteration;
+a body's table instructions are compiled once (:mod:`.compiled`) and fall back to the
+general path on any iteration that could need a diagnostic.
 ISA extensions (``ts`` of the hybrid extension, :mod:`rend3r.isa.extensions`) are accepted
 only once enabled, by ``isa_ext=`` or a ``.isa_ext`` directive.
 """
@@ -13,6 +15,7 @@ from __future__ import annotations
 import difflib
 import os
 from dataclasses import dataclass, field
+from fractions import Fraction
 from pathlib import Path
 from typing import Iterable, Mapping
 
@@ -22,6 +25,7 @@ from ..isa.extensions import EXTENSIONS
 from ..isa.tables import F_MNEMONICS, MNEMONIC_TABLE
 from ..isa.targets import TARGETS, Target
 from .diagnostics import ERROR, WARNING, Diagnostic, format_all
+from .compiled import Words, compile_instruction, plain_number
 from .expressions import POISON, EvalError, Value, describe, evaluate, fold
 from .fastpath import fast_line
 from .operands import PAIRS, OperandEncoder
@@ -82,6 +86,16 @@ class AssemblyResult:
     diagnostics: list[Diagnostic] = field(default_factory=list)
     mnemonics_used: set[str] = field(default_factory=set)
     stopped_at: int = 0  # the max_errors limit the run stopped at (0: it ran to its end)
+    #: the files the run read or looked for, resolved, in reading order: the source and each
+    #: .include (one not found: the path beside the including file), for a watcher to follow
+    files: list[Path] = field(default_factory=list)
+
+    @property
+    def mode(self) -> str:
+        """The frame mode the program calls for (as ``rend3r emulate`` runs it): hybrid
+        when it uses ``ts``, raster when it uses ``tr``, else raytrace."""
+        used = self.mnemonics_used
+        return "hybrid" if "ts" in used else "raster" if "tr" in used else "raytrace"
 
     @property
     def ok(self) -> bool:
@@ -125,6 +139,7 @@ class _Stmt:
     line: int
     text: str
     cost: int = 1  # what it counts against MAX_STATEMENTS (see _cost)
+    words: Words | None = None  # compiled (a .rept body's instruction): see compiled.py
 
 
 @dataclass
@@ -199,12 +214,14 @@ class Assembler:
         self._seen: set[tuple] = set()
         self.mnemonics: set[str] = set()
         self.env: dict[str, Value] = {}
+        self.plain: dict[str, int | Fraction] = {}  # the env's plain numbers (compiled.plain_number)
         self.defined_at: dict[str, str] = {}
         self.scopes: list[list[str]] = []  # constants defined in each running .rept iteration
         self.include_stack: list[Path] = []
         # (including file, name) -> path, resolved path, text (None: not found or not read)
         self.includes: dict[tuple[str, str], tuple[Path, Path, str] | None] = {}
         self.include_depth = 0
+        self.files: dict[Path, None] = {}  # AssemblyResult.files, in order
         self.statements = 0
         self.lines_read = 0
         self.parsed = 0  # characters sent to the full grammar
@@ -335,7 +352,9 @@ class Assembler:
                     body = None
                     self.run_rept(done, context)
             elif body is not None:
-                body.append(_Stmt(_folded(stmt), file, lineno, line, _cost(stmt)))
+                folded = _folded(stmt)
+                words = compile_instruction(folded, limits) if fast else None
+                body.append(_Stmt(folded, file, lineno, line, _cost(stmt), words))
             else:
                 self.run_statement(_Stmt(stmt, file, lineno, line, _cost(stmt)), context)
         for node in open_repts:
@@ -398,18 +417,20 @@ class Assembler:
         if count is None or (len(args) == 2 and var is None):
             return
         self.rept_depth += 1
+        where = f"{node.file}:{node.line}"
         try:
             for i in range(count):
                 label = f"{var}={i}" if var else f"#{i}"
-                inner = (f"in .rept iteration {label} ({node.file}:{node.line})", *context)
+                inner = (f"in .rept iteration {label} ({where})", *context)
                 self.scopes.append([])
                 if var:
-                    self.define(var, Value(i), f"{node.file}:{node.line}")
+                    self.define(var, Value(i), where)
                 for item in node.body:
                     self.run_item(item, inner)
                 for name in self.scopes.pop():
                     del self.env[name]
                     del self.defined_at[name]
+                    self.plain.pop(name, None)
         finally:
             self.rept_depth -= 1
 
@@ -417,7 +438,11 @@ class Assembler:
         self.where = (item.file, item.line, item.text, context)
         self.count_statement(item.cost)
         stmt = item.stmt
-        if isinstance(stmt, Instruction):
+        words = item.words(self.plain) if item.words is not None else None
+        if words is not None:
+            loc = SourceLoc(item.file, item.line, stmt.col)
+            self.emit_instruction(stmt.mnemonic.lower(), words, loc, item.text, context)
+        elif isinstance(stmt, Instruction):
             words = self.operands.instruction(stmt)
             if words is not None:
                 loc = SourceLoc(item.file, item.line, stmt.col)
@@ -432,6 +457,9 @@ class Assembler:
     def define(self, name: str, value: Value, where: str) -> None:
         self.env[name] = value
         self.defined_at[name] = where
+        number = plain_number(value)
+        if number is not None:
+            self.plain[name] = number
         if self.scopes:
             self.scopes[-1].append(name)
 
@@ -568,10 +596,12 @@ class Assembler:
             except (OSError, RuntimeError) as exc:  # a name too long, a symlink loop
                 problem = problem or f": {getattr(exc, 'strerror', None) or exc}"
         else:
+            self.files.setdefault(Path(os.path.abspath(candidates[0])))
             searched = ", ".join(str(p.parent) for p in candidates)
             self.error(f"cannot find include file '{quote(arg.text)}'{problem} (searched: {quote(searched)})",
                        arg.col, arg.end)
             return None
+        self.files.setdefault(real)
         text = read_source(candidate, self.error_at(arg))
         return None if text is None else (candidate, real, text)
 
@@ -611,7 +641,7 @@ def read_source(path: Path, error) -> str | None:
 
 def _result(asm: Assembler, werror: bool) -> AssemblyResult:
     diagnostics = [d.as_error() for d in asm.diagnostics] if werror else asm.diagnostics
-    return AssemblyResult(Program(asm.entries), diagnostics, asm.mnemonics, asm.stopped_at)
+    return AssemblyResult(Program(asm.entries), diagnostics, asm.mnemonics, asm.stopped_at, list(asm.files))
 
 
 def assemble_source(
@@ -629,13 +659,14 @@ def assemble_source(
     (the current directory for ``<input>``), then to each of ``include_paths``.
     ``isa_ext`` names ISA extensions to enable from the start (``"hybrid"``, or several;
     a source can also enable them with ``.isa_ext``). ``fast=False`` parses every line
-    with the full grammar (for testing the fast path). ``max_errors`` stops the run at
+    with the full grammar and runs .rept bodies uncompiled (for testing the fast paths). ``max_errors`` stops the run at
     that many errors (0: no limit; the result's ``stopped_at`` says it stopped).
     """
     asm = Assembler(include_paths, target, fast, isa_ext, max_errors, werror)
     try:
         if filename != "<input>":
             asm.include_stack.append(Path(filename).resolve())
+            asm.files.setdefault(asm.include_stack[0])
         asm.where = (filename, 0, "", ())
         asm.count_read(text, 0)
         asm.run_text(text, filename)
@@ -659,6 +690,7 @@ def assemble_file(
     bytes) is an error diagnostic."""
     asm = Assembler(include_paths, target, isa_ext=isa_ext)
     name = str(path)
+    asm.files.setdefault(Path(os.path.abspath(path)))
     text = read_source(Path(path), lambda message: asm.diagnostics.append(Diagnostic(ERROR, message, name, 0)))
     if text is None:
         return _result(asm, werror)

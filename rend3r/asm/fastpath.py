@@ -185,6 +185,23 @@ _SD1 = SD_DATA.lo
 _SD2 = SD_DATA2.lo
 
 
+def camera_word(prop: int, data: int) -> int:
+    """The C word setting camera property ``prop`` to 16 data bits (fields unchecked)."""
+    return data << _DATA | prop << _PROP | _C_BASE
+
+
+def light_word(index: int, prop: int, data: int) -> int:
+    """The L word setting property ``prop`` of light ``index`` (fields unchecked)."""
+    return data << _DATA | prop << _PROP | index << _LIDX | _L_BASE
+
+
+def shape_words(index: int, prop: int, prop2: int, data: int, data2: int) -> tuple[int, int]:
+    """The SE and SD words setting two properties of shape or triangle ``index``
+    (fields unchecked)."""
+    se = (index >> 3) << _SEHI | prop << _PROP | prop2 << _SEP2 | (index & 7) << _SELO | _SE_BASE
+    return se, data << _SD1 | data2 << _SD2
+
+
 def fast_line(text: str, limits: dict[str, int] | None = None) -> tuple | None:
     """Encode a simple line: ``()`` for nothing, ``(mnemonic, words, column)`` for an
     instruction, None when the full parser must handle it.
@@ -209,19 +226,18 @@ def fast_line(text: str, limits: dict[str, int] | None = None) -> tuple | None:
             or (limits and index >= limits[mn])
         ):
             return None
-        se = (index >> 3) << _SEHI | pv[0] << _PROP | qw[0] << _SEP2 | (index & 7) << _SELO | _SE_BASE
-        return mn, (se, pv[1] << _SD1 | qw[1] << _SD2), m.start(9) + 1
+        return mn, shape_words(index, pv[0], qw[0], pv[1], qw[1]), m.start(9) + 1
     if lt:
         index = int(li)
         pv = _value("lt", lp, lv)
         if pv is None or index >= LIGHT_INDEX_LIMIT or (limits and index >= limits["lt"]):
             return None
-        return "lt", (pv[1] << _DATA | pv[0] << _PROP | index << _LIDX | _L_BASE,), m.start(5) + 1
+        return "lt", (light_word(index, pv[0], pv[1]),), m.start(5) + 1
     if c:
         pv = _value("cam", cp, cv)
         if pv is None:
             return None
-        return "cam", (pv[1] << _DATA | pv[0] << _PROP | _C_BASE,), m.start(2) + 1
+        return "cam", (camera_word(pv[0], pv[1]),), m.start(2) + 1
     if f:
         mn = f.lower()
         return mn, (_F_WORDS[mn],), m.start(1) + 1

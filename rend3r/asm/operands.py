@@ -36,8 +36,9 @@ from .parser import Instruction, Operand, Ref
 _EXTENSION_OF = {m: name for name, ms in EXTENSIONS.items() for m in ms}
 #: ``ts`` operand -> the table it selects
 TS_TABLES = {"shape": Table.SHAPE, "triangle": Table.TRIANGLE}
-_OPERANDS = {"cam": "PROP, VALUE", "lt": "INDEX, PROP, VALUE", "sp": "INDEX, PROP, PROP2, VALUE, VALUE2"}
-_OPERANDS["tr"] = _OPERANDS["sp"]
+#: each table mnemonic's operands, as a message names them
+OPERANDS = {"cam": "PROP, VALUE", "lt": "INDEX, PROP, VALUE", "sp": "INDEX, PROP, PROP2, VALUE, VALUE2"}
+OPERANDS["tr"] = OPERANDS["sp"]
 #: the SE/SD mnemonics, whose table TS selects under the hybrid extension
 PAIRS = ("sp", "tr")
 _REGISTER = re.compile(r"a(\d+)", re.IGNORECASE)
@@ -61,6 +62,11 @@ class Host(Protocol):
     def integer(self, node: Operand, what: str, lo: int, limit: int) -> int | None: ...
 
     def source(self, node: Operand) -> str: ...
+
+
+def find_property(table: Table, name: str) -> Property | None:
+    """The property ``name`` (any of its names, or an original assembler's name) of ``table``."""
+    return lookup(table, name) or ORIGINAL_NAMES[table].get(name.lower())
 
 
 class OperandEncoder:
@@ -96,10 +102,10 @@ class OperandEncoder:
                 hint = f"; did you mean '{close[0]}'?" if close else ""
                 host.error(f"unknown mnemonic '{stmt.mnemonic}'{hint}", stmt.col, stmt.end)
             return None
-        expected = _OPERANDS[m].count(",") + 1
+        expected = OPERANDS[m].count(",") + 1
         if len(ops) != expected:
             end = ops[-1].end if ops else stmt.end
-            host.error(f"'{m}' takes {expected} operands ({_OPERANDS[m]}), got {len(ops)}", stmt.col, end)
+            host.error(f"'{m}' takes {expected} operands ({OPERANDS[m]}), got {len(ops)}", stmt.col, end)
             return None
         if m == "cam":
             prop = self.prop(table, ops[0])
@@ -174,7 +180,7 @@ class OperandEncoder:
         if not isinstance(node, Ref):
             host.error(f"expected a {table.value} property name, got '{host.source(node)}'", node.col, node.end)
             return None
-        prop = lookup(table, node.name) or ORIGINAL_NAMES[table].get(node.name.lower())
+        prop = find_property(table, node.name)
         if prop is not None:
             return prop
         reg = _REGISTER.fullmatch(node.name)

@@ -60,6 +60,4 @@ def _assemble(p: Path) -> LoadedProgram:
     from ..asm.assembler import assemble_or_raise
 
     result = assemble_or_raise(p)
-    used = result.mnemonics_used
-    mode = "hybrid" if "ts" in used else "raster" if "tr" in used else "raytrace"
-    return LoadedProgram(list(result.program.words), mode)
+    return LoadedProgram(list(result.program.words), result.mode)

@@ -2,9 +2,8 @@
 
 A source is assembled with the assembler's own :func:`assemble_file`, so its diagnostics
 keep their file, line, column and span; a failed reload keeps the last good words. The
-files watched are the program, every file its words came from (its ``.include`` files)
-and the source files beside them, since an included file that only defines names emits
-no word of its own.
+files watched are those the last assembly read or looked for (``AssemblyResult.files``:
+the program and every ``.include``, also one that only defines names or was not found).
 """
 
 from __future__ import annotations
@@ -16,11 +15,9 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..asm.formats.recognise import SOURCE_SUFFIXES, kind_by_name
+from ..asm.formats.recognise import kind_by_name
 from ..errors import Rend3rError
 
-#: Source files of one folder looked at for changes (the rest of a huge folder is ignored).
-MAX_WATCHED_PER_DIR = 256
 #: A change is read once the files have stood still this long: an editor's save may
 #: truncate a file and then write it, and the half-way file is not the program.
 SETTLE_S = 0.05
@@ -64,17 +61,9 @@ class ProgramSource:
         self._lock = threading.Lock()
 
     def signature(self) -> tuple:
-        """(path, mtime, size) of every watched file and of the source files beside them."""
-        seen: set[Path] = set()
-        for f in self._files:
-            seen.add(f)
-            try:
-                beside = sorted(p for p in f.parent.iterdir() if p.suffix.lower() in SOURCE_SUFFIXES)
-            except OSError:
-                continue
-            seen.update(beside[:MAX_WATCHED_PER_DIR])
+        """(path, mtime, size) of every watched file (None, None for one missing)."""
         out = []
-        for f in sorted(seen):
+        for f in sorted(self._files):
             try:
                 st = f.stat()
             except OSError:
@@ -124,11 +113,8 @@ class ProgramSource:
 
         refuse_foreign_file(self.path)
         result = assemble_file(self.path, max_errors=MAX_ERRORS)
-        self._files = {self.path, *(Path(e.loc.file) for e in result.program.entries if e.loc is not None),
-                       *(Path(d.file) for d in result.diagnostics if d.line)}
+        self._files = {self.path, *result.files}
         diagnostics = [diagnostic_json(d) for d in result.diagnostics]
         if not result.ok:
             return None, diagnostics, result.format_diagnostics()
-        used = result.mnemonics_used
-        mode = "hybrid" if "ts" in used else "raster" if "tr" in used else "raytrace"
-        return Good(tuple(result.program.words), mode), diagnostics, ""
+        return Good(tuple(result.program.words), result.mode), diagnostics, ""

@@ -21,6 +21,25 @@ def test_result_program_and_mnemonics():
     assert (e.address, e.loc.file, e.loc.line, e.loc.col, e.text) == (2, "p.asm", 3, 1, "tr 0, x1, y1, 1, 2")
 
 
+@pytest.mark.parametrize("source, mode", [("nr\ncam xloc, 1\n", "raytrace"), ("nr\ntr 0, x1, y1, 1, 2\n", "raster"),
+                                          (".isa_ext hybrid\nts triangle\ntr 0, x1, y1, 1, 2\n", "hybrid")])
+def test_mode_follows_the_mnemonics_used(source, mode):
+    assert assemble_source(source + "er\ner\n").mode == mode
+
+
+def test_files_read_in_order_resolved_and_a_missing_include_where_it_was_looked_for(tmp_path: Path):
+    (tmp_path / "lib").mkdir()
+    (tmp_path / "lib" / "a.inc").write_text('.include "b.inc"\n.include "gone.inc"\n')
+    (tmp_path / "lib" / "b.inc").write_text("B = 1\n")
+    main = tmp_path / "main.asm"
+    main.write_text('.rept 3\n.include "lib/../lib/a.inc"\n.endr\ner\ner\n')
+    r = assemble_file(main)
+    assert r.files == [main.resolve(), tmp_path.resolve() / "lib" / "a.inc", tmp_path.resolve() / "lib" / "b.inc",
+                       tmp_path / "lib" / "gone.inc"]
+    assert assemble_file(tmp_path / "none.asm").files == [tmp_path / "none.asm"]
+    assert assemble_source("nr\ner\ner\n").files == []
+
+
 def test_mem_output_is_the_original_format():
     r = assemble_source("nr\nsp 3, xloc, yloc, 0.5, -0\ner\ner")
     assert render("mem", r.program) == b"00000200\n0000089d\n38008000\n00000000\n00000000\n"

@@ -148,16 +148,21 @@ def test_live_reload_pushes_over_the_websocket_and_keeps_the_last_good_frame_on_
     assert "Traceback" not in s.stderr_text and "rend3r view:" not in s.stderr_text
 
 
-def test_an_included_file_that_only_defines_names_is_watched(tmp_path):
-    inc = tmp_path / "colour.asm"
+def test_the_files_the_assembler_read_are_watched(tmp_path):
+    """An include in another folder that only defines names, and one created after the
+    program failed for want of it (the assembler's AssemblyResult.files)."""
+    (tmp_path / "lib").mkdir()
+    inc = tmp_path / "lib" / "colour.asm"
     inc.write_text("COLOUR = 0xF800\n")
     main_file = tmp_path / "scene.asm"
-    main_file.write_text('.include "colour.asm"\n' + SPHERE)
+    main_file.write_text('.include "lib/colour.asm"\n' + SPHERE)
     with serve(main_file) as s:
-        version = _status(s)["version"]
-        inc.write_text("COLOUR = 0x001F\n")
-        st = wait_for(lambda: (st := _status(s))["version"] > version and st)
-        assert st["ok"]
+        assert _status(s)["ok"]
+        inc.write_text('.include "shade.asm"\n')
+        st = wait_for(lambda: not (st := _status(s))["ok"] and st)
+        assert "cannot find include file 'shade.asm'" in st["message"]
+        (tmp_path / "lib" / "shade.asm").write_text("COLOUR = 0x001F\n")
+        assert wait_for(lambda: _status(s)["ok"])
         blue = _png(s.request("/api/image/frame.png?size=64x48")[2])
         assert blue[24, 32, 2] > 0 and blue[24, 32, 0] == 0
 

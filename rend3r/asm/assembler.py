@@ -140,6 +140,7 @@ class _Stmt:
     text: str
     cost: int = 1  # what it counts against MAX_STATEMENTS (see _cost)
     words: Words | None = None  # compiled (a .rept body's instruction): see compiled.py
+    loc: SourceLoc | None = None  # where its words come from, made once for every iteration
 
 
 @dataclass
@@ -354,7 +355,7 @@ class Assembler:
             elif body is not None:
                 folded = _folded(stmt)
                 words = compile_instruction(folded, limits) if fast else None
-                body.append(_Stmt(folded, file, lineno, line, _cost(stmt), words))
+                body.append(_Stmt(folded, file, lineno, line, _cost(stmt), words, SourceLoc(file, lineno, stmt.col)))
             else:
                 self.run_statement(_Stmt(stmt, file, lineno, line, _cost(stmt)), context)
         for node in open_repts:
@@ -440,8 +441,7 @@ class Assembler:
         stmt = item.stmt
         words = item.words(self.plain) if item.words is not None else None
         if words is not None:
-            loc = SourceLoc(item.file, item.line, stmt.col)
-            self.emit_instruction(stmt.mnemonic.lower(), words, loc, item.text, context)
+            self.emit_instruction(stmt.mnemonic.lower(), words, item.loc, item.text, context)
         elif isinstance(stmt, Instruction):
             words = self.operands.instruction(stmt)
             if words is not None:

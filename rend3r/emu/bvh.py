@@ -3,7 +3,9 @@ log(shapes).
 
 Built once per frame from the shapes' centres (``csrc/kernels.c`` bvh_build: median splits
 across the longest side, leaves of at most 4 shapes); each bundle of rays then refits its
-boxes to the balls of its own cull radii and its depth floors (bvh_refit). Shapes without a
+node bounds to the balls of its own cull radii, and its depth floors (bvh_refit): double
+cones around the apex of lines through one point, boxes on the plane normal to parallel
+lines. Shapes without a
 finite bound stay outside the tree and every ray tests them. ``csrc/bvh.h`` explains why
 skipping a node never changes the nearest hit.
 """
@@ -30,25 +32,42 @@ class Tree:
     def nodes(self) -> int:
         return len(self.node)
 
-    def struct(self, box: np.ndarray) -> native.Bvh:
-        """The kernels' view with one bundle's node boxes (the arrays must outlive it)."""
-        native.ptr(box, np.float64, (self.nodes, native.BV_COLUMNS))
-        return native.Bvh(self.node.ctypes.data, self.items.ctypes.data, box.ctypes.data, self.nodes,
-                          self.always.ctypes.data, len(self.always))
-
-    def refit(self, bnd: np.ndarray, radius: np.ndarray, floor: np.ndarray | None = None) -> np.ndarray:
-        """Node boxes (nodes, BV_COLUMNS) holding the balls (centre, ``radius``) of their
-        shapes, padded outwards, and their least ``floor`` (None: -inf)."""
+    def refit(self, bnd: np.ndarray, radius: np.ndarray, floor: np.ndarray | None = None, *,
+              apex: np.ndarray | None = None, axes: np.ndarray | None = None) -> Bounds:
+        """One bundle's node bounds around the balls (centre, ``radius``) of their shapes,
+        and their least ``floor`` (None: -inf): the double cones around ``apex`` (lines
+        through it) or the boxes on the two unit ``axes`` (2, 3) normal to parallel lines."""
         n = len(bnd)
         native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
         radius = np.ascontiguousarray(radius, np.float64)
         native.ptr(radius, np.float64, (n,))
         if floor is not None:
             native.ptr(floor, np.float64, (n,))
-        box = np.empty((self.nodes, native.BV_COLUMNS))
-        native.library().bvh_refit(self.struct(box), bnd.ctypes.data, radius.ctypes.data,
-                                   None if floor is None else floor.ctypes.data, box.ctypes.data)
-        return box
+        if (apex is None) == (axes is None):
+            raise ValueError("refit: give the apex of the lines or the axes normal to them")
+        kind = native.BVH_CONE if apex is not None else native.BVH_FLAT
+        frame = np.zeros(6)
+        frame[: 3 if apex is not None else 6] = np.ravel(apex if apex is not None else axes)
+        bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame)
+        native.library().bvh_refit(bounds.struct(), bnd.ctypes.data, radius.ctypes.data,
+                                   None if floor is None else floor.ctypes.data, kind, frame.ctypes.data,
+                                   bounds.box.ctypes.data)
+        return bounds
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """A tree's node bounds for one bundle of rays, and the bundle's apex or axes."""
+
+    tree: Tree
+    box: np.ndarray  # (nodes, BV_COLUMNS) float64
+    frame: np.ndarray  # 6 float64
+
+    def struct(self) -> native.Bvh:
+        """The kernels' view (the arrays must outlive it)."""
+        t = self.tree
+        return native.Bvh(t.node.ctypes.data, t.items.ctypes.data, self.box.ctypes.data, (*self.frame,), t.nodes,
+                          t.always.ctypes.data, len(t.always))
 
 
 def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:

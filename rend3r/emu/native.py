@@ -33,7 +33,8 @@ LIGHT_DIRECTIONAL, LIGHT_POINT = 1, 2
 TRACE_SHAPE_VALUES, TRACE_LIGHT_VALUES = 22, 12
 OUT_TESTS, OUT_NAN_TESTS, OUT_SHADOW_RAYS, OUT_HITS, OUT_LO, OUT_HI, OUT_COLUMNS = 0, 1, 2, 3, 4, 7, 10
 PC_COLUMNS = 7
-BV_FLOOR, BV_COLUMNS = 6, 7  # shape hierarchy node boxes: lo, hi corners, least depth floor
+BVH_CONE, BVH_FLAT = 0, 1  # a hierarchy's bounds around lines through one apex, or parallel lines
+BV_ANGLE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 4, 5, 6  # their columns (csrc/kernels.h)
 
 
 class Format(Structure):
@@ -56,8 +57,8 @@ class Shapes(Structure):
 
 
 class Bvh(Structure):
-    _fields_ = [("node", c_void_p), ("items", c_void_p), ("box", c_void_p), ("nodes", c_int64), ("always", c_void_p),
-                ("nalways", c_int64)]
+    _fields_ = [("node", c_void_p), ("items", c_void_p), ("box", c_void_p), ("frame", c_double * 6),
+                ("nodes", c_int64), ("always", c_void_p), ("nalways", c_int64)]
 
 
 class Band(Structure):
@@ -117,7 +118,7 @@ _PLAIN = {
     "behind_keys": (None, [c_void_p, c_void_p, c_int64, c_double, c_void_p]),
     "bvh_keys": (None, [POINTER(Bvh), c_void_p, c_void_p]),
     "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p]),
-    "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_void_p, c_void_p, c_void_p]),
+    "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_void_p, c_void_p, c_int32, c_void_p, c_void_p]),
     "bound_radii": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_int32, c_void_p]),
     "bound_floors": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double,
                             c_void_p]),

@@ -262,8 +262,8 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
         band.dirs = a["dirs"].ctypes.data
         parts = _run(fr.jobs, n_pix, fr.kernel("directions"), band, np.array([0.0, np.inf, 0.0]))
         extent = (float(parts[:, 1].min()), float(parts[:, 2].max())) if parts[:, 0].sum() else (0.0, 0.0)
-    box, floor, pc = _primary_tree(fr, *extent)
-    band.pc, band.floor, band.tree = pc.ctypes.data, floor.ctypes.data, fr.tree.struct(box)
+    primary, floor, pc = _primary_tree(fr, *extent)
+    band.pc, band.floor, band.tree = pc.ctypes.data, floor.ctypes.data, primary.struct()
     for name in ("slot", "sqd", "pt", "nm", "bad", "nan_px"):
         setattr(band, name, a[name].ctypes.data)
     c = _report(_run(fr.jobs, row1 - row0, fr.kernel("nearest"), band, _OUT, max(1, MIN_CHUNK // w)))
@@ -292,8 +292,8 @@ def _extent(fr: _Frame, row0: int, row1: int) -> tuple[float, float] | None:
             float(np.sqrt(np.max(xs**2) + np.max(ys**2) + z * z)))
 
 
-def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The hierarchy's boxes for the primary rays (directions dmin..dmax long), and per
+def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> tuple[bvh.Bounds, np.ndarray, np.ndarray]:
+    """The hierarchy's bounds for the primary rays (directions dmin..dmax long), and per
     shape its depth floor and cull data."""
     apex = fr.cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)
     bounded = fr.bounded & bool(np.isfinite(apex).all())
@@ -305,7 +305,7 @@ def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> tuple[np.ndarray, np.
     pc = np.empty((len(radius), native.PC_COLUMNS))
     native.library().bound_primary(fr.bnd.ctypes.data, radius.ctypes.data, len(radius), apex.ctypes.data, dmin, u,
                                    tiny, pc.ctypes.data)
-    return fr.tree.refit(fr.bnd, radius, floor), floor, pc
+    return fr.tree.refit(fr.bnd, radius, floor, apex=apex), floor, pc
 
 
 def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.ndarray, acc: np.ndarray,
@@ -323,7 +323,7 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
     lp.first = int(k == 0)
     if shadows:  # lp points into the arrays of sb: they live until the pass is done
         sb = _shadow_bounds(fr, lp, light, hits, n_pix)
-        lp.tree, lp.radius, lp.along = fr.tree.struct(sb.box), sb.radius.ctypes.data, sb.along.ctypes.data
+        lp.tree, lp.radius, lp.along = sb.bounds.struct(), sb.radius.ctypes.data, sb.along.ctypes.data
         if sb.behind is not None:
             lp.behind, lp.keys = sb.behind.ctypes.data, sb.keys.ctypes.data
             lp.l_len, lp.l_hat[:] = _unit(light[native.LT_DIR:native.LT_DIR + 3])
@@ -346,7 +346,7 @@ class _ShadowBounds:
     (csrc/kernels.h LightPass) and the hierarchy's boxes for these rays."""
 
     radius: np.ndarray  # cull radius per shape
-    box: np.ndarray  # node boxes (bvh.Tree.refit)
+    bounds: bvh.Bounds  # the hierarchy's bounds for these rays
     along: np.ndarray  # a directional light's l in normal space and a2, per shape
     behind: np.ndarray | None = None  # a directional light's behind terms per shape
     keys: np.ndarray | None = None  # ... and per node the largest stop keys below it
@@ -361,7 +361,8 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
     centers = fr.bnd[:, :3]
     along = np.zeros((0, 4), fr.dtype)
     none = np.full(n, np.inf)
-    unbounded = _ShadowBounds(none, fr.tree.refit(fr.bnd, none), along)  # every ray tests every shape
+    everywhere = {"axes": np.eye(3)[:2]} if lp.parallel else {"apex": np.zeros(3)}  # bounds of infinite radii
+    unbounded = _ShadowBounds(none, fr.tree.refit(fr.bnd, none, **everywhere), along)  # every ray tests every shape
     if not hits[native.OUT_HITS]:
         return unbounded
     lo, hi = hits[native.OUT_LO:native.OUT_LO + 3], hits[native.OUT_HI:native.OUT_HI + 3]
@@ -379,8 +380,8 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
         bounded = fr.bounded & bool(np.isfinite(apex).all())
         radius = bounds.cull_radii(fr.bnd, bounded, far, float(origins[9]), u, tiny, fr.fp16, fr.jobs)
         radius += far * (origins[7] * (1 + bounds.SLACK) + 1e-15) + slack
-        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius), along)
-    length, _ = _unit(light[native.LT_DIR:native.LT_DIR + 3])
+        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex), along)
+    length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
         return unbounded
     radius = bounds.cull_radii(fr.bnd, fr.bounded, far, length, u, tiny, fr.fp16, fr.jobs) + slack
@@ -389,10 +390,10 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
     behind = _behind_terms(fr, radius, light)
     lib, keys = native.library(), np.empty((n, 3))
     lib.behind_keys(behind.ctypes.data, radius.ctypes.data, n, length, keys.ctypes.data)
-    box = fr.tree.refit(fr.bnd, radius)
+    flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit))
     node_keys = np.empty((fr.tree.nodes, 3))
-    lib.bvh_keys(fr.tree.struct(box), keys.ctypes.data, node_keys.ctypes.data)
-    return _ShadowBounds(radius, box, along, behind, node_keys)
+    lib.bvh_keys(flat.struct(), keys.ctypes.data, node_keys.ctypes.data)
+    return _ShadowBounds(radius, flat, along, behind, node_keys)
 
 
 def _unit(v: np.ndarray) -> tuple[float, np.ndarray]:
@@ -423,3 +424,10 @@ def _report_origins(outs: np.ndarray) -> np.ndarray:
     out[:3], out[3:6], out[6:8] = outs[:, :3].min(axis=0), outs[:, 3:6].max(axis=0), outs[:, 6:8].max(axis=0)
     out[8], out[9] = outs[:, 8].sum(), outs[:, 9].min()
     return out
+
+
+def _normal_plane(d: np.ndarray) -> np.ndarray:
+    """Two orthonormal vectors (2, 3) normal to the unit vector d."""
+    e1 = np.cross(d, [1.0, 0.0, 0.0] if abs(d[0]) < 0.9 else [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    return np.stack([e1, np.cross(d, e1)])

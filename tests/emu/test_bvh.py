@@ -56,40 +56,77 @@ def test_every_bounded_shape_is_in_exactly_one_leaf(n, seed, clustered):
     assert max((d for _, d in nodes), default=0) + 2 < STACK
 
 
-@settings(max_examples=40, derandomize=True)
-@given(st.integers(1, 500), st.integers(0, 2**32 - 1))
-def test_boxes_hold_the_balls_and_floors_are_the_least(n, seed):
+def shapes(n: int, seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """n balls at scales from 1e-3 to 1e3 (a few without a radius) and their floors."""
     rng = np.random.default_rng(seed)
     bnd = table(rng.normal(size=(n, 3)) * 10.0 ** rng.integers(-3, 4, size=(n, 1)))
     radius = rng.random(n) * 10.0 ** rng.integers(-3, 3, size=n)
     radius[rng.random(n) < 0.05] = np.inf
-    floor = rng.random(n)
-    tree = bvh.build(bnd, np.ones(n, bool))
-    box = tree.refit(bnd, radius, floor)
+    return bnd, radius, rng.random(n)
+
+
+def leaves(tree: bvh.Tree):
+    """(node, shape slots below it) of every node."""
     for at, _ in walk(tree):
         first, count = (int(v) for v in tree.node[at])
-        below = tree.items[first:first + count] if count else None
-        if below is None:  # the union of the children
-            left, right = box[at + 1], box[first]
-            assert (box[at, :3] == np.minimum(left[:3], right[:3])).all()
-            assert (box[at, 3:6] == np.maximum(left[3:6], right[3:6])).all()
-            assert box[at, native.BV_FLOOR] == min(left[native.BV_FLOOR], right[native.BV_FLOOR])
+        yield at, (tree.items[first:first + count] if count else leaves_below(tree, at))
+
+
+def leaves_below(tree: bvh.Tree, at: int) -> np.ndarray:
+    first, count = (int(v) for v in tree.node[at])
+    if count:
+        return tree.items[first:first + count]
+    return np.concatenate([leaves_below(tree, at + 1), leaves_below(tree, first)])
+
+
+@settings(max_examples=30, derandomize=True)
+@given(st.integers(1, 300), st.integers(0, 2**32 - 1))
+def test_cones_hold_every_line_through_the_apex_that_meets_a_ball(n, seed):
+    bnd, radius, floor = shapes(n, seed)
+    rng = np.random.default_rng(seed + 1)
+    apex = rng.normal(size=3)
+    tree = bvh.build(bnd, np.ones(n, bool))
+    b = tree.refit(bnd, radius, floor, apex=apex).box
+    for at, below in leaves(tree):
+        assert b[at, native.BV_FLOOR] == floor[below].min()
+        # lines from the apex to points on the balls' surfaces (the extreme ones among them)
+        c, r = bnd[below, :3] - apex, radius[below]
+        finite = np.isfinite(r) & (np.linalg.norm(c, axis=1) > r)
+        if not finite.all():
+            assert b[at, native.BV_SIN2] == np.inf
             continue
-        c, r = bnd[below, :3], radius[below, None]
-        assert (box[at, :3] <= c - r).all() and (box[at, 3:6] >= c + r).all()
-        assert box[at, native.BV_FLOOR] == floor[below].min()
+        offsets = rng.normal(size=(len(below), 3))
+        w = c + r[:, None] * offsets / np.linalg.norm(offsets, axis=1)[:, None]
+        cross = np.cross(w, b[at, :3])
+        assert ((cross**2).sum(axis=1) <= (w**2).sum(axis=1) * b[at, native.BV_SIN2]).all()
 
 
-def test_a_nan_radius_gives_an_infinite_box():
-    bnd = table(np.zeros((2, 3)))
+@settings(max_examples=30, derandomize=True)
+@given(st.integers(1, 300), st.integers(0, 2**32 - 1))
+def test_flat_boxes_hold_every_ball_projected_on_the_axes(n, seed):
+    bnd, radius, _ = shapes(n, seed)
+    axes = np.array([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0]])
+    tree = bvh.build(bnd, np.ones(n, bool))
+    b = tree.refit(bnd, radius, axes=axes).box
+    for at, below in leaves(tree):
+        uv, r = bnd[below, :3] @ axes.T, radius[below]
+        assert (b[at, 0] <= uv[:, 0] - r).all() and (b[at, 1] >= uv[:, 0] + r).all()
+        assert (b[at, 2] <= uv[:, 1] - r).all() and (b[at, 3] >= uv[:, 1] + r).all()
+        assert b[at, native.BV_FLOOR] == -np.inf  # no floors given
+
+
+def test_a_nan_radius_bounds_nothing():
+    bnd = table(np.zeros((2, 3)) + 5.0)
     tree = bvh.build(bnd, np.ones(2, bool))
-    box = tree.refit(bnd, np.array([1.0, np.nan]))
-    assert (box[0, :3] == -np.inf).all() and (box[0, 3:6] == np.inf).all()
-    assert box[0, native.BV_FLOOR] == -np.inf  # no floors given
+    assert tree.refit(bnd, np.array([1.0, np.nan]), apex=np.zeros(3)).box[0, native.BV_SIN2] == np.inf
+    flat = tree.refit(bnd, np.array([1.0, np.nan]), axes=np.eye(3)[:2]).box[0]
+    assert (flat[[0, 2]] == -np.inf).all() and (flat[[1, 3]] == np.inf).all()
 
 
 def test_refit_checks_its_arrays():
     bnd = table(np.zeros((3, 3)))
     tree = bvh.build(bnd, np.ones(3, bool))
     with pytest.raises(TypeError):
-        tree.refit(bnd, np.ones(2))
+        tree.refit(bnd, np.ones(2), apex=np.zeros(3))
+    with pytest.raises(ValueError):
+        tree.refit(bnd, np.ones(3))

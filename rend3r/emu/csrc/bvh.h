@@ -2,11 +2,15 @@
  * kernels.c bvh_build, bvh_refit).
  *
  * The topology depends on the shapes' centres only. Each bundle of rays then gets its own
- * boxes (bvh_refit): a node's box holds the balls (centre, cull radius) of its shapes, the
- * radii being those of that bundle (bounds.h), padded outwards, and a node's floor is the
- * least depth floor below it. A line that misses a node's box passes farther than the
- * cull radius from every centre below it, so each of those shapes is provably missed, as
- * the per-shape tests would find; a node whose floor lies beyond every lane's nearest hit
+ * bounds (bvh_refit) around the balls (centre, cull radius) of the shapes below a node,
+ * the radii being that bundle's (bounds.h): for lines through one apex (primary rays
+ * from the camera; a point light's shadow rays, whose radii cover the rounding of l) the
+ * double cone around the apex holding every line that meets one of the balls; for
+ * parallel lines (a directional light's) the box holding the balls' discs on two axes
+ * normal to them. A line outside a node's bound passes farther than the cull radius
+ * from every centre below it, so each of those shapes is provably missed, as the
+ * per-shape tests would find; and a node's floor is the least depth floor below it: a
+ * node whose floor lies beyond every lane's nearest hit
  * holds no shape that can win or tie. Skipping such nodes changes which shapes are
  * tested, never the nearest hit (the tie rule orders by index, not by testing order).
  */
@@ -24,35 +28,23 @@
 #define BVH_LEAF 4
 #define BVH_STACK 64
 
-/* A line's parameter interval within one slab, [near, far], from (lo - o) * inv and
- * (hi - o) * inv: NaN (a line in the slab's plane, or NaN operands) gives every t. */
-static inline void slab4(f64x4 t1, f64x4 t2, f64x4 *near, f64x4 *far)
+/* Lanes whose line through the apex along w (w: the lane's direction, ww = |w|^2) lies
+ * outside a node's cone: |w x axis|^2 > ww sin^2, the squared sine of the angle between
+ * them exactly where it is small (no cancellation, unlike the cosine); the cone's sine
+ * is widened by 1e-9, far beyond these products' few ulps. NaN never lies outside. */
+static inline i64x4 cone_missed4(const double *b, f64x4 w0, f64x4 w1, f64x4 w2, f64x4 ww)
 {
-    i64x4 nan = (t1 != t1) | (t2 != t2);
-    const f64x4 inf = {INFINITY, INFINITY, INFINITY, INFINITY};
-    f64x4 lo = (f64x4)SEL_BITS((u64x4)(t1 < t2), (u64x4)t1, (u64x4)t2);
-    f64x4 hi = (f64x4)SEL_BITS((u64x4)(t1 < t2), (u64x4)t2, (u64x4)t1);
-    lo = (f64x4)SEL_BITS((u64x4)nan, (u64x4)-inf, (u64x4)lo);
-    hi = (f64x4)SEL_BITS((u64x4)nan, (u64x4)inf, (u64x4)hi);
-    *near = (f64x4)SEL_BITS((u64x4)(lo > *near), (u64x4)lo, (u64x4)*near);
-    *far = (f64x4)SEL_BITS((u64x4)(hi < *far), (u64x4)hi, (u64x4)*far);
+    f64x4 c0 = w1 * b[BV_AXIS + 2] - w2 * b[BV_AXIS + 1];
+    f64x4 c1 = w2 * b[BV_AXIS] - w0 * b[BV_AXIS + 2];
+    f64x4 c2 = w0 * b[BV_AXIS + 1] - w1 * b[BV_AXIS];
+    return c0 * c0 + c1 * c1 + c2 * c2 > ww * b[BV_SIN2];
 }
 
-/* Lanes whose line o + t inv^-1 (any t) provably misses the box: the slabs' intervals do
- * not meet, by more than their rounding (each t carries a relative error of a few ulps:
- * a subtraction and a product of exact doubles). NaN never misses. */
-static inline i64x4 box_missed4(const double *bx, f64x4 o0, f64x4 o1, f64x4 o2, f64x4 i0, f64x4 i1, f64x4 i2)
+/* Lanes whose parallel line, at (u, v) on the axes normal to the lines, lies outside a
+ * node's box. NaN never lies outside. */
+static inline i64x4 flat_missed4(const double *b, f64x4 u, f64x4 v)
 {
-    const f64x4 inf = {INFINITY, INFINITY, INFINITY, INFINITY};
-    f64x4 near = -inf, far = inf;
-    slab4((bx[BV_LO] - o0) * i0, (bx[BV_HI] - o0) * i0, &near, &far);
-    slab4((bx[BV_LO + 1] - o1) * i1, (bx[BV_HI + 1] - o1) * i1, &near, &far);
-    slab4((bx[BV_LO + 2] - o2) * i2, (bx[BV_HI + 2] - o2) * i2, &near, &far);
-    const f64x4 shrink = {1.0 - 1e-12, 1.0 - 1e-12, 1.0 - 1e-12, 1.0 - 1e-12};
-    const f64x4 grow = {1.0 + 1e-12, 1.0 + 1e-12, 1.0 + 1e-12, 1.0 + 1e-12};
-    f64x4 a = near * (f64x4)SEL_BITS((u64x4)(near > 0), (u64x4)shrink, (u64x4)grow);
-    f64x4 b = far * (f64x4)SEL_BITS((u64x4)(far > 0), (u64x4)grow, (u64x4)shrink);
-    return a > b;
+    return (u < b[BV_U0]) | (u > b[BV_U1]) | (v < b[BV_V0]) | (v > b[BV_V1]);
 }
 
 #endif

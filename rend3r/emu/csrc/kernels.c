@@ -99,36 +99,108 @@ int64_t bvh_build(const double *bnd, int32_t *items, int64_t n, int32_t *node)
     return count;
 }
 
-/* One bundle's node boxes (t->nodes x BV_COLUMNS into box): each node's box holds the
- * balls (centre, radius) of its shapes, padded outwards by 1e-9 of the radius and 1e-12
- * of the centre's size (an infinite or NaN radius: an infinite box), and the least of
- * their floors (NULL: -inf). Children follow their parent, so nodes go last to first. */
-void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const double *floor, double *box)
+#define HALF_PI 1.5707963267948966  /* M_PI_2 is not C11 */
+
+/* The double cone (unit axis a, half-angle t; t >= pi/2: every line) around the apex
+ * holding cones 1 and 2 (lines: a2 flipped into a1's hemisphere), widened by 1e-12 of
+ * the angle and 1e-12 rad at every step for the rounding of the construction. */
+static void cone_union(double *a1, double *t1, const double *a2_, double t2)
+{
+    double a2[3] = {a2_[0], a2_[1], a2_[2]}, dot = a1[0] * a2[0] + a1[1] * a2[1] + a1[2] * a2[2];
+    if (dot < 0) {
+        a2[0] = -a2[0]; a2[1] = -a2[1]; a2[2] = -a2[2]; dot = -dot;
+    }
+    double w[3] = {a2[0] - dot * a1[0], a2[1] - dot * a1[1], a2[2] - dot * a1[2]};
+    double sine = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), phi = atan2(sine, dot) * (1.0 + 1e-12) + 1e-15;
+    if (*t1 >= HALF_PI || phi + t2 <= *t1)
+        return;
+    if (t2 >= HALF_PI || phi + *t1 <= t2 || !(sine > 1e-9)) {
+        double keep = t2 >= *t1 ? t2 : *t1;
+        if (t2 >= *t1)
+            memcpy(a1, a2, sizeof a2);
+        *t1 = sine > 1e-9 ? t2 : keep + phi;
+        return;
+    }
+    double t = (phi + *t1 + t2) / 2, turn = t - *t1;
+    for (int c = 0; c < 3; c++)
+        a1[c] = cos(turn) * a1[c] + sin(turn) * w[c] / sine;
+    double len = sqrt(a1[0] * a1[0] + a1[1] * a1[1] + a1[2] * a1[2]);
+    for (int c = 0; c < 3; c++)
+        a1[c] /= len;
+    *t1 = t * (1.0 + 1e-12) + 1e-12;
+}
+
+/* A node's bound from its shapes' balls (centre c, cull radius r; an infinite or NaN
+ * radius, or an apex inside the ball, bounds nothing). BVH_CONE: the double cone around
+ * the apex (frame[0..3)) of the lines meeting the balls, half-angle asin(r / distance)
+ * widened as cone_union widens; BVH_FLAT: the box of the discs the balls project to on the
+ * unit axes frame[0..3), frame[3..6) normal to parallel lines, padded by 1e-9 of the
+ * radius and 1e-12 of the centre's projection. */
+static void node_add(double *b, int kind, const double *frame, const double *c, double r)
+{
+    if (kind == BVH_FLAT) {
+        double u = c[0] * frame[0] + c[1] * frame[1] + c[2] * frame[2];
+        double v = c[0] * frame[3] + c[1] * frame[4] + c[2] * frame[5];
+        double ru = r < INFINITY ? r * (1.0 + 1e-9) + 1e-12 * fabs(u) : INFINITY;
+        double rv = r < INFINITY ? r * (1.0 + 1e-9) + 1e-12 * fabs(v) : INFINITY;
+        b[BV_U0] = MIN(b[BV_U0], u - ru); b[BV_U1] = MAX(b[BV_U1], u + ru);
+        b[BV_V0] = MIN(b[BV_V0], v - rv); b[BV_V1] = MAX(b[BV_V1], v + rv);
+        return;
+    }
+    double e[3] = {c[0] - frame[0], c[1] - frame[1], c[2] - frame[2]};
+    double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    int ball = dist > r && r < INFINITY && dist < INFINITY;
+    double angle = ball ? asin(r / dist) * (1.0 + 1e-12) + 1e-12 : HALF_PI;
+    for (int k = 0; k < 3 && ball; k++)
+        e[k] /= dist;
+    if (b[BV_ANGLE] < 0) {
+        memcpy(b + BV_AXIS, e, sizeof e);
+        b[BV_ANGLE] = angle;
+    } else {
+        cone_union(b + BV_AXIS, &b[BV_ANGLE], e, angle);
+    }
+}
+
+/* One bundle's node bounds (t->nodes x BV_COLUMNS into box; kind and frame as node_add
+ * takes them) from the shapes' cull radii, and each node's least floor (NULL: -inf).
+ * Children follow their parent, so nodes go last to first; a cone gets the squared sine
+ * of its half-angle (inf from pi/2 on: every line) for the kernels' test. */
+void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const double *floor, int32_t kind,
+               const double *frame, double *box)
 {
     for (int64_t at = t->nodes - 1; at >= 0; at--) {
         double *b = box + BV_COLUMNS * at;
         int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
-        for (int k = 0; k < 3; k++) { b[BV_LO + k] = INFINITY; b[BV_HI + k] = -INFINITY; }
+        if (kind == BVH_FLAT) {
+            b[BV_U0] = b[BV_V0] = INFINITY;
+            b[BV_U1] = b[BV_V1] = -INFINITY;
+        } else {
+            b[BV_AXIS] = b[BV_AXIS + 1] = 0.0;
+            b[BV_AXIS + 2] = 1.0;
+            b[BV_ANGLE] = -1.0;  /* no line yet */
+        }
         b[BV_FLOOR] = INFINITY;
         if (count == 0) {
             const double *l = box + BV_COLUMNS * (at + 1), *r = box + BV_COLUMNS * (int64_t)first;
-            for (int k = 0; k < 3; k++) {
-                b[BV_LO + k] = MIN(l[BV_LO + k], r[BV_LO + k]);
-                b[BV_HI + k] = MAX(l[BV_HI + k], r[BV_HI + k]);
+            if (kind == BVH_FLAT) {
+                b[BV_U0] = MIN(l[BV_U0], r[BV_U0]); b[BV_U1] = MAX(l[BV_U1], r[BV_U1]);
+                b[BV_V0] = MIN(l[BV_V0], r[BV_V0]); b[BV_V1] = MAX(l[BV_V1], r[BV_V1]);
+            } else {
+                memcpy(b + BV_AXIS, l + BV_AXIS, 3 * sizeof(double));
+                b[BV_ANGLE] = l[BV_ANGLE];
+                cone_union(b + BV_AXIS, &b[BV_ANGLE], r + BV_AXIS, r[BV_ANGLE]);
             }
             b[BV_FLOOR] = MIN(l[BV_FLOOR], r[BV_FLOOR]);
-            continue;
-        }
-        for (int32_t i = first; i < first + count; i++) {
-            int64_t s = t->items[i];
-            const double *c = bnd + B_COLUMNS * s;
-            double r = radius[s];
-            r = r < INFINITY ? r * (1.0 + 1e-9) + 1e-12 * (fabs(c[0]) + fabs(c[1]) + fabs(c[2])) : INFINITY;
-            for (int k = 0; k < 3; k++) {
-                b[BV_LO + k] = MIN(b[BV_LO + k], c[k] - r);
-                b[BV_HI + k] = MAX(b[BV_HI + k], c[k] + r);
+        } else {
+            for (int32_t i = first; i < first + count; i++) {
+                int64_t s = t->items[i];
+                node_add(b, kind, frame, bnd + B_COLUMNS * s, radius[s] == radius[s] ? radius[s] : INFINITY);
+                b[BV_FLOOR] = MIN(b[BV_FLOOR], floor != NULL ? floor[s] : -INFINITY);
             }
-            b[BV_FLOOR] = MIN(b[BV_FLOOR], floor != NULL ? floor[s] : -INFINITY);
+        }
+        if (kind == BVH_CONE) {
+            double sine = sin(b[BV_ANGLE]);
+            b[BV_SIN2] = b[BV_ANGLE] < HALF_PI && b[BV_AXIS] == b[BV_AXIS] ? sine * sine * (1.0 + 1e-9) : INFINITY;
         }
     }
 }

@@ -54,15 +54,20 @@ typedef struct {
     const Format *format;   /* the _fmt kernels' format (NULL for the others) */
 } Shapes;
 
-/* Shape hierarchy node columns (double, per bundle of rays): box corners lo, hi, the least
- * depth floor below (csrc/bvh.h). */
-enum { BV_LO = 0, BV_HI = 3, BV_FLOOR = 6, BV_COLUMNS = 7 };
+/* Shape hierarchy node columns (double, per bundle of rays; csrc/bvh.h): a bundle through
+ * one apex (BVH_CONE) gets the double cone holding the lines that meet the balls below
+ * (unit axis, half-angle, its squared sine), parallel lines (BVH_FLAT) the box of the
+ * balls' discs on two axes normal to them; then the least depth floor below. */
+enum { BVH_CONE = 0, BVH_FLAT = 1 };
+enum { BV_AXIS = 0, BV_ANGLE = 3, BV_SIN2 = 4, BV_U0 = 0, BV_U1 = 1, BV_V0 = 2, BV_V1 = 3, BV_FLOOR = 5,
+       BV_COLUMNS = 6 };
 
 typedef struct {
     const int32_t *node;    /* per node: right child (inner) or first item (leaf), item count (0: inner);
                                an inner node's left child is the next node */
     const int32_t *items;   /* shape slots, leaf by leaf */
     const double *box;      /* nodes x BV_COLUMNS, for one bundle of rays (bvh_refit) */
+    double frame[6];        /* that bundle's apex (BVH_CONE) or two unit axes normal to its lines (BVH_FLAT) */
     int64_t nodes;
     const int32_t *always;  /* shape slots outside the tree (no finite bound): every ray tests them */
     int64_t nalways;

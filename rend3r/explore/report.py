@@ -35,7 +35,7 @@ class Results:
         return {f: self.scores[program.name, f] for f in self.formats}
 
 
-def _db(value: float) -> str:
+def decibels(value: float) -> str:
     return "inf" if math.isinf(value) else f"{value:.2f}"
 
 
@@ -47,7 +47,7 @@ def results_csv(r: Results) -> bytes:
     for p in r.programs:
         for f in r.formats:
             s, c = r.scores[p.name, f], r.costs[f]
-            w.writerow([p.name, p.mode, p.frames, f, r.subnormals, _db(s.psnr), s.max_channel, f"{s.differing:.6f}",
+            w.writerow([p.name, p.mode, p.frames, f, r.subnormals, decibels(s.psnr), s.max_channel, f"{s.differing:.6f}",
                         f"{s.provenance:.6f}", f"{s.interior_provenance:.6f}", c.lut, c.ff, c.dsp,
                         int(s.psnr >= r.min_psnr)])
     return out.getvalue().encode()
@@ -110,27 +110,32 @@ def pareto_svg(r: Results) -> bytes:
     return "\n".join(parts).encode()
 
 
+def summary_header(r: Results, title: str, command: str, conditions: str) -> list[str]:
+    """The opening lines of a summary.md: title, command, size, subnormals and ``conditions``."""
+    w, h = r.size
+    return [f"# {title}", "", f"`{command}`", "", f"{w}x{h}, subnormals {r.subnormals}, scored against fp64; {conditions}",
+            ""]
+
+
 def summary_md(r: Results, command: str) -> bytes:
     """Per program the cheapest format meeting the bound, then per format its cost."""
-    w, h = r.size
-    lines = [f"# rend3r explore: {len(r.programs)} program(s) x {len(r.formats)} format(s)", "",
-             f"`{command}`", "",
-             (f"{w}x{h}, subnormals {r.subnormals}, scored against fp64; a format meets the bound when its PSNR "
-             f"is at least {r.min_psnr:g} dB. Cost: the raytrace and raster datapaths' units "
-             "(`rend3r.precision.datapath`) times each unit's modelled cost (`rend3r.precision.cost`); "
-             "the cheapest is the one with fewest LUTs."), "",
+    title = f"rend3r explore: {len(r.programs)} program(s) x {len(r.formats)} format(s)"
+    conditions = (f"a format meets the bound when its PSNR is at least {r.min_psnr:g} dB. Cost: the raytrace and "
+                  "raster datapaths' units (`rend3r.precision.datapath`) times each unit's modelled cost "
+                  "(`rend3r.precision.cost`); the cheapest is the one with fewest LUTs.")
+    lines = [*summary_header(r, title, command, conditions),
              "| program | mode | cheapest meeting the bound | " + " | ".join(f"{f} PSNR" for f in r.formats) + " |",
              "|---|---|---|" + "---:|" * len(r.formats)]
     for p in r.programs:
         by_format = r.of_program(p)
         best = cheapest(by_format, r.costs, r.min_psnr)
         lines.append(f"| {p.name} | {p.mode} | {best or 'none'} | "
-                     + " | ".join(_db(by_format[f].psnr) for f in r.formats) + " |")
+                     + " | ".join(decibels(by_format[f].psnr) for f in r.formats) + " |")
     lines += ["", "| format | LUT | FF | DSP48E1 | worst PSNR (dB) | programs meeting the bound |",
               "|---|---:|---:|---:|---:|---:|"]
     for f in r.formats:
         c, scores = r.costs[f], r.of_format(f)
         meeting = sum(s.psnr >= r.min_psnr for s in scores)
-        lines.append(f"| {f} | {c.lut:,} | {c.ff:,} | {c.dsp:,} | {_db(worst_psnr(scores))} | "
+        lines.append(f"| {f} | {c.lut:,} | {c.ff:,} | {c.dsp:,} | {decibels(worst_psnr(scores))} | "
                      f"{meeting}/{len(scores)} |")
     return ("\n".join(lines) + "\n").encode()

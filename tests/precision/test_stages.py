@@ -195,3 +195,24 @@ def test_every_stage_is_costed_from_its_own_counts():
     fp16 = parse("fp16")
     for stage in STAGES:
         assert counts.cost(fp16, {stage: parse("fp32")}).lut > counts.cost(fp16).lut, stage
+
+
+def test_render_all_takes_stage_formats(tmp_path):
+    """render-all renders with the map: the same PNG as emulate with it, another than without."""
+    from click.testing import CliRunner
+
+    from rend3r.cli import main
+
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "shadow.asm").write_text((ROOT / "programs/shadow.asm").read_text())
+    runs = {}
+    for name, extra in (("staged", ["--stage-precision", "discriminant=e5m3,hit=e4m3"]), ("plain", [])):
+        r = CliRunner().invoke(main, ["render-all", str(src), "-o", str(tmp_path / name), "--size", "32x24",
+                                      "--scheduler", "none", "--quiet", *extra])
+        assert r.exit_code == 0, r.output
+        runs[name] = (tmp_path / name / "shadow.png").read_bytes()
+    r = CliRunner().invoke(main, ["emulate", str(src / "shadow.asm"), "-o", str(tmp_path / "e.png"), "--size", "32x24",
+                                  "--stage-precision", "discriminant=e5m3,hit=e4m3", "--quiet"])
+    assert r.exit_code == 0, r.output
+    assert runs["staged"] == (tmp_path / "e.png").read_bytes() != runs["plain"]

@@ -21,8 +21,9 @@ if TYPE_CHECKING:
     from .campaign import ProgramSpec, Score
 
 DEFAULT_FORMATS = "fp16,bf16,tf32,fp24,fp32"
-#: --search's default ladder, each format cheaper in every operator than the one before.
-DEFAULT_LADDER = "fp32,fp24,e6m13,fp16"
+#: --search's default ladder, each format cheaper in every operator than the one before, all
+#: with fp32's exponent range (so every design is culled: docs/precision.md section 7).
+DEFAULT_LADDER = "fp32,e8m16,e8m13,tf32"
 
 
 def parse_formats(ctx: click.Context, param: click.Parameter, value: str) -> list[str]:
@@ -64,7 +65,7 @@ def load_spec(path: Path):
                    "a base with formats per stage, BASE:STAGE=FORMAT+STAGE=FORMAT (fp32:sqrt=fp16+hit=bf16).")
 @click.option("--search", is_flag=True,
               help="Greedy per-stage narrowing down --ladder while every program keeps --min-psnr "
-                   "(instead of --formats).")
+                   "(instead of --formats; docs/precision.md section 7).")
 @click.option("--ladder", default=DEFAULT_LADDER, show_default=True, callback=parse_formats, metavar="LIST",
               help="--search: the formats a stage may take, widest first, each cheaper than the one before.")
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True,
@@ -92,10 +93,11 @@ def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str
     (docs/campaigns.md); the results do not depend on where they ran.
 
     With --search, the designs are found instead of given: every stage of the raytrace
-    datapath starts at the ladder's first format, and round by round the stage whose
-    narrowing saves the most LUTs per dB of worst PSNR lost (every program staying at
-    --min-psnr) narrows one rung, until none can; summary.md shows the path and per
-    program the cheapest design visited that meets the bound.
+    datapath, and the base format the rasterizer works in, starts at the ladder's first
+    format, and round by round the part whose narrowing saves the most LUTs per dB of
+    worst PSNR lost (every program staying at --min-psnr) narrows one rung, until none
+    can; summary.md shows the path and per program the cheapest design visited that
+    meets the bound.
 
     \b
     Example:

@@ -12,6 +12,8 @@ from xml.sax.saxutils import escape
 from ..precision.datapath import Resources
 from .campaign import ProgramSpec, Score, cheapest, worst_psnr
 
+#: Above this many designs, pareto.svg names only the front's points (each point's name is its tooltip).
+MAX_LABELS = 12
 COLUMNS = ("program", "mode", "frames", "format", "subnormals", "psnr_db", "max_channel", "differing_share",
            "provenance_share", "interior_provenance_share", "lut", "ff", "dsp", "meets_min_psnr")
 
@@ -102,10 +104,13 @@ def pareto_svg(r: Results) -> bytes:
     front = pareto_front(points)
     line = " ".join(f"{x(points[f][0].lut):.1f},{y(points[f][1]):.1f}" for f in front)
     parts.append(f'<polyline points="{line}" fill="none" stroke="steelblue" stroke-width="2"/>')
+    labelled = set(front) if len(points) > MAX_LABELS else set(points)  # a search's many designs: the front's
     for f, (c, psnr) in points.items():
         colour = "steelblue" if f in front else "grey"
-        parts.append(f'<circle cx="{x(c.lut):.1f}" cy="{y(psnr):.1f}" r="4" fill="{colour}"/>')
-        parts.append(f'<text x="{x(c.lut) + 6:.1f}" y="{y(psnr) - 6:.1f}">{escape(f)}</text>')
+        parts.append(f'<circle cx="{x(c.lut):.1f}" cy="{y(psnr):.1f}" r="4" fill="{colour}"><title>{escape(f)}'
+                     '</title></circle>')
+        if f in labelled:
+            parts.append(f'<text x="{x(c.lut) + 6:.1f}" y="{y(psnr) - 6:.1f}">{escape(f)}</text>')
     parts.append("</svg>\n")
     return "\n".join(parts).encode()
 

@@ -92,3 +92,24 @@ def test_search_refuses_formats_and_a_bad_ladder(tmp_path):
     r = CliRunner().invoke(main, [*base, "--ladder", "fp16,fp32"])
     assert r.exit_code == 2 and "widest first" in r.output
     assert not (tmp_path / "x").exists()
+
+
+def test_pareto_of_many_designs_names_the_front_only(tmp_path):
+    import xml.etree.ElementTree as ET
+
+    from rend3r.explore.campaign import ProgramSpec
+    from rend3r.explore.report import MAX_LABELS, Results, pareto_front, pareto_svg
+
+    designs = [design_name("fp32", {s: "fp16" for s in STAGES[:k]}) for k in range(len(STAGES) + 1)]
+    designs += [design_name("fp16", {s: "fp32" for s in STAGES[:k]}) for k in range(1, 6)]
+    assert len(designs) > MAX_LABELS
+    spec = ProgramSpec("p", (), "raytrace", 1)
+    scores = {("p", d): s[0] for d, s in model(designs).items()}
+    costs = {d: design_cost(d) for d in designs}
+    r = Results([spec], designs, scores, costs, 40.0, "ftz", (8, 6))
+    root = ET.fromstring(pareto_svg(r))
+    ns = {"s": "http://www.w3.org/2000/svg"}
+    assert len(root.findall("s:circle", ns)) == len(designs)
+    named = {t.text for t in root.findall("s:text", ns)} & set(designs)
+    front = pareto_front({d: (costs[d], scores["p", d].psnr) for d in designs})
+    assert named == set(front)

@@ -94,7 +94,7 @@ def test_search_refuses_formats_and_a_bad_ladder(tmp_path):
     assert not (tmp_path / "x").exists()
 
 
-def test_pareto_of_many_designs_names_the_front_only(tmp_path):
+def test_pareto_of_many_designs_names_the_front_only():
     import xml.etree.ElementTree as ET
 
     from rend3r.explore.campaign import ProgramSpec

@@ -76,6 +76,14 @@ PRECISION = click.option(
     help="Working precision: fp16 (the device), fp32, fp64, or any binary format eEmM (E exponent bits 2..11, "
          "M fraction bits 1..52) or alias bf16, tf32, fp24 (docs/precision.md).")
 
+#: ``--stage-precision STAGE=FORMAT[,...]``: a format per stage of the raytrace datapath.
+STAGE_PRECISION = click.option(
+    "--stage-precision", type=CheckedType("STAGE=FORMAT,...", "rend3r.precision.stages:parse_stage_map"),
+    default=None, metavar="STAGE=FORMAT,...",
+    help="Formats of single stages of the raytrace datapath (the others use --precision): camera, transform, "
+         "quadratic, discriminant, sqrt, distance, hit, lighting, colour; e.g. discriminant=e8m15,lighting=fp16 "
+         "(docs/precision.md).")
+
 
 #: ``--jobs N``: threads rendering each frame (0, the default: every core this process may use).
 JOBS = click.option("--jobs", type=click.IntRange(0, 256), default=0, show_default=True, metavar="N",

@@ -15,6 +15,11 @@ Every operation rounds its result to the working format, as one hardware unit wo
   ``e5m10``, ``e8m23`` and ``e11m52`` are fp16, fp32 and fp64 themselves. ``tininess``
   ``"before"`` (a device quirk) flushes results whose unrounded value is below the
   smallest normal, so fp16 then runs as such a format too.
+- per stage (``stages``, :mod:`rend3r.precision.stages`): each stage of the raytrace
+  datapath in its own format, the base precision for the others. An operation rounds its
+  operands to its stage's format (the converter a value crosses between stages), then
+  computes correctly rounded in it; scene values stay exact float16 until an operation
+  reads them. Values are held in float64.
 
 Arrays are held as float32 for fp16 and fp32 (fp16 values are exact in float32), float64
 otherwise. Overflow gives infinities and invalid operations NaN, silently here: callers
@@ -32,6 +37,7 @@ import numpy as np
 
 from ..precision import ops
 from ..precision.formats import FloatFormat, FormatError, Tininess, parse
+from ..precision.stages import current_stage, stage_text
 
 #: A working precision: "fp16", "fp32", "fp64" or another format's name ("e8m7").
 Precision = str
@@ -61,18 +67,37 @@ class Arith:
     precision: Precision = "fp16"
     ftz: bool = True
     tininess: Tininess = "after"  # with ftz: a result is tiny judged after rounding, or before
+    stages: tuple[tuple[str, Precision], ...] = ()  # (stage, precision) differing from the base (make_arith)
 
     @cached_property
     def format(self) -> FloatFormat:
-        """The working format (fp32 and fp64 never flush)."""
-        ftz = self.ftz and self.precision not in ("fp32", "fp64")
-        return parse(self.precision, "ftz" if ftz else "ieee")
+        """The working format (fp32 and fp64 never flush); the base format when staged."""
+        return self._format_of(self.precision)
+
+    def _format_of(self, precision: Precision) -> FloatFormat:
+        ftz = self.ftz and precision not in ("fp32", "fp64")
+        return parse(precision, "ftz" if ftz else "ieee")
+
+    @cached_property
+    def stage_formats(self) -> dict[str, FloatFormat]:
+        """Each listed stage's format (the others use :attr:`format`)."""
+        return {stage: self._format_of(p) for stage, p in self.stages}
+
+    def stage_precision(self, stage: str | None) -> Precision:
+        """The precision of a stage (None: outside the stages, the base)."""
+        return dict(self.stages).get(stage or "", self.precision)
 
     @property
     def native(self) -> bool:
         """fp16, fp32 or fp64 as the device's IP rounds them: kernels of their own, float32
-        or float64 arrays (fp16 judging tininess before rounding runs as any other format)."""
-        return self.precision in PRECISIONS and (self.tininess == "after" or not self.format.ftz)
+        or float64 arrays (fp16 judging tininess before rounding runs as any other format,
+        and so does any per-stage map)."""
+        return (not self.stages and self.precision in PRECISIONS
+                and (self.tininess == "after" or not self.format.ftz))
+
+    def _here(self) -> FloatFormat:
+        """The format of the stage the current operation is made in."""
+        return self.stage_formats.get(current_stage(3) or "", self.format)
 
     @property
     def dtype(self) -> type[np.floating]:
@@ -80,29 +105,43 @@ class Arith:
 
     @property
     def unit_roundoff(self) -> float:
-        """Half an ulp of 1: the largest relative error of one rounding (normal range)."""
-        return self.format.unit_roundoff
+        """Half an ulp of 1: the largest relative error of one rounding (normal range), as
+        the culling bounds use it. Per stage: 4 times the largest of the formats', since an
+        operation may round both operands on entering its stage and then its result
+        ((1 + u)**3 - 1 < 4u)."""
+        if not self.stages:
+            return self.format.unit_roundoff
+        return 4 * max(f.unit_roundoff for f in (self.format, *self.stage_formats.values()))
 
     @property
     def tiny(self) -> float:
-        """The smallest normal number: below it results flush or lose relative precision."""
-        return self.format.min_normal
+        """The smallest normal number (per stage: the largest of the formats'): below it
+        results flush or lose relative precision."""
+        return max(f.min_normal for f in (self.format, *self.stage_formats.values()))
+
+    @property
+    def exp_bits(self) -> int:
+        """The fewest exponent bits of the working format or any stage's."""
+        return min(f.exp_bits for f in (self.format, *self.stage_formats.values()))
 
     @property
     def label(self) -> str:
+        extra = f" [{stage_text(self.stages)}]" if self.stages else ""
         if self.precision in ("fp32", "fp64"):
-            return self.precision
+            return self.precision + extra
         if self.ftz and self.tininess == "before":
-            return f"{self.precision}-ftz-before"
-        return f"{self.precision}-{'ftz' if self.ftz else 'ieee'}"
+            return f"{self.precision}-ftz-before{extra}"
+        return f"{self.precision}-{'ftz' if self.ftz else 'ieee'}{extra}"
 
-    def bits(self, value: float) -> tuple[int, int]:
-        """A working-precision value's bit pattern in the working format (NaN: the quiet NaN
-        of its sign, fp32 and fp64 as they hold it), and the pattern's width in hex digits."""
-        if self.precision in _NATIVE_BITS:
-            ftype, itype = _NATIVE_BITS[self.precision]
+    def bits(self, value: float, stage: str | None = None) -> tuple[int, int]:
+        """A working-precision value's bit pattern in the format of its stage (None: the
+        working format; NaN: the quiet NaN of its sign, fp32 and fp64 as they hold it),
+        and the pattern's width in hex digits."""
+        precision = self.stage_precision(stage)
+        if precision in _NATIVE_BITS:
+            ftype, itype = _NATIVE_BITS[precision]
             return int(np.asarray(value, dtype=ftype).view(itype)), np.dtype(itype).itemsize * 2
-        f, v = self.format, float(value)
+        f, v = self.stage_formats.get(stage or "", self.format), float(value)
         top = (1 << f.exp_bits) - 1
         if math.isnan(v):
             e, m = top, 1 << (f.frac_bits - 1)
@@ -116,7 +155,10 @@ class Arith:
         return (int(math.copysign(1, v) < 0) << (f.bits - 1)) | (e << f.frac_bits) | m, -(-f.bits // 4)
 
     def round(self, x: np.ndarray | float) -> np.ndarray:
-        """Round values (already in or above working precision) to the working format."""
+        """Round values (already in or above working precision) to the working format (the
+        current stage's, when staged)."""
+        if self.stages:
+            return self._here().round(np.asarray(x, dtype=np.float64), tininess=self.tininess)
         if not self.native:
             return self.format.round(np.asarray(x, dtype=np.float64), tininess=self.tininess)
         if self.precision != "fp16":
@@ -136,33 +178,44 @@ class Arith:
 
     def add(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         if not self.native:
-            return ops.add(self.format, a, b, tininess=self.tininess)
+            return self._binary(ops.add, a, b)
         with np.errstate(all="ignore"):
             return self.round(np.add(a, b, dtype=self.dtype))
 
     def sub(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         if not self.native:
-            return ops.sub(self.format, a, b, tininess=self.tininess)
+            return self._binary(ops.sub, a, b)
         with np.errstate(all="ignore"):
             return self.round(np.subtract(a, b, dtype=self.dtype))
 
     def mul(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         if not self.native:
-            return ops.mul(self.format, a, b, tininess=self.tininess)
+            return self._binary(ops.mul, a, b)
         with np.errstate(all="ignore"):
             return self.round(np.multiply(a, b, dtype=self.dtype))
 
     def div(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         if not self.native:
-            return ops.div(self.format, a, b, tininess=self.tininess)
+            return self._binary(ops.div, a, b)
         with np.errstate(all="ignore"):
             return self.round(np.divide(a, b, dtype=self.dtype))
 
     def sqrt(self, a: np.ndarray) -> np.ndarray:
         if not self.native:
-            return ops.sqrt(self.format, a, tininess=self.tininess)
+            f = self._here() if self.stages else self.format
+            return ops.sqrt(f, self._enter(f, a), tininess=self.tininess)
         with np.errstate(all="ignore"):
             return self.round(np.sqrt(np.asarray(a, dtype=self.dtype)))
+
+    def _binary(self, op, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        if not self.stages:
+            return op(self.format, a, b, tininess=self.tininess)
+        f = self._here()
+        return op(f, self._enter(f, a), self._enter(f, b), tininess=self.tininess)
+
+    def _enter(self, f: FloatFormat, a: np.ndarray) -> np.ndarray:
+        """An operand through the converter into the stage's format (staged only)."""
+        return f.round(np.asarray(a, dtype=np.float64), tininess=self.tininess) if self.stages else a
 
     def neg(self, a: np.ndarray) -> np.ndarray:
         """Negation flips the sign bit: exact in every format."""
@@ -171,6 +224,8 @@ class Arith:
     def from_bits(self, bits: np.ndarray | int) -> np.ndarray:
         """float16 bit patterns (as stored by the ISA) to working-precision values."""
         h = np.asarray(bits, dtype=np.uint16).view(np.float16)
+        if self.stages:  # exact: each operation converts what it reads
+            return h.astype(np.float64)
         return self.round(h.astype(self.dtype))
 
 
@@ -221,6 +276,10 @@ def _round16_f32(a: np.ndarray, ftz: bool) -> np.ndarray:
 
 
 def make_arith(precision: Precision = "fp16", subnormals: Literal["ftz", "ieee"] = "ftz",
-               tininess: Tininess = "after") -> Arith:
-    """The arithmetic for a ``--precision`` / ``--subnormals`` pair (ValueError for a bad name)."""
-    return Arith(precision_name(precision), subnormals == "ftz", tininess)
+               tininess: Tininess = "after", stages: tuple[tuple[str, Precision], ...] = ()) -> Arith:
+    """The arithmetic for a ``--precision`` / ``--subnormals`` pair and a per-stage map
+    (``--stage-precision``; stages in the base precision are dropped, so a uniform map is
+    the plain working precision). ValueError for a bad name."""
+    base = precision_name(precision)
+    differing = tuple((s, p) for s, p in ((s, precision_name(p)) for s, p in stages) if p != base)
+    return Arith(base, subnormals == "ftz", tininess, differing)

@@ -9,7 +9,7 @@ from contextlib import contextmanager
 
 import click
 
-from ..cliutil import JOBS, MAX_MEMORY, PRECISION, SIZE
+from ..cliutil import JOBS, MAX_MEMORY, PRECISION, SIZE, STAGE_PRECISION
 from ..progress import Progress, quiet_option
 from ..errors import Rend3rError
 
@@ -55,6 +55,7 @@ def _pattern(ctx, param, value: str | None) -> str | None:
 @click.option("--frames", type=click.IntRange(min=1), metavar="N", help="Render at most N frames (required for programs that loop with lr).")
 @click.option("--mode", type=click.Choice(["raytrace", "raster", "hybrid"]), help="How SE/SD data is read (default: from the source's sp/tr, else raytrace); hybrid: shapes and triangles in one frame (docs/isa-extensions.md).")
 @PRECISION
+@STAGE_PRECISION
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="Subnormals of fp16 and the other narrow formats: flush to zero (the device's IP) or IEEE gradual underflow.")
 @click.option("--size", type=SIZE, default="512x384", show_default=True, help="Image size WxH (1..8192 each).")
 @click.option("--background", default="0x0000", show_default=True, callback=_colour, metavar="RGB565", help="RGB565 colour where no shape is hit.")
@@ -72,7 +73,7 @@ def _pattern(ctx, param, value: str | None) -> str | None:
 @JOBS
 @MAX_MEMORY
 @quiet_option
-def emulate_command(program, output, frames, mode, precision, subnormals, size, background, visibility,
+def emulate_command(program, output, frames, mode, precision, stage_precision, subnormals, size, background, visibility,
                     depth_path, prov_path, gif_path, apng_path, show_stats, profile, quirks, trace_pixels,
                     trace_path, jobs, max_memory, quiet) -> None:
     """Run a REND3R PROGRAM (source or memory image) and render its frames.
@@ -111,7 +112,7 @@ def emulate_command(program, output, frames, mode, precision, subnormals, size, 
         if path:
             check_output(path, kinds)  # the extension; folders are checked by reserve()
     loaded = load_program(program)
-    options = EmuOptions(precision=precision, subnormals=subnormals, mode=mode or loaded.mode_hint or "raytrace",
+    options = EmuOptions(precision=precision, stage_precision=stage_precision or (), subnormals=subnormals, mode=mode or loaded.mode_hint or "raytrace",
                          width=size[0], height=size[1], background=background, depth=visibility, jobs=jobs)
     selected = quirk_names(profile, quirks)
     _refuse_contradictions(selected, profile, quirks, subnormals=subnormals, visibility=visibility)

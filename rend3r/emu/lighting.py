@@ -34,6 +34,11 @@ def fixed_intensity(f: np.ndarray) -> np.ndarray:
     return ((k + half) & ((1 << FIXED_BITS) - 1)) - half
 
 
+def light_factor(ar: Arith, cos: np.ndarray, intensity: np.ndarray) -> np.ndarray:
+    """f = cos * intensity: the factor the colour is scaled by (the colour stage)."""
+    return ar.mul(cos, intensity)
+
+
 def diffuse(
     ar: Arith,
     base: np.ndarray,
@@ -69,7 +74,7 @@ def diffuse(
         l_len = ar.sqrt(dot(ar, l_vec, l_vec))
         denom = ar.mul(nn, l_len)
         cos = ar.div(n_dot_l, denom)
-        f = ar.mul(cos, light.intensity)
+        f = light_factor(ar, cos, light.intensity)
         for name, value in (("n_dot_l", n_dot_l), ("n_len", nn), ("l_len", l_len), ("denom", denom),
                             ("cos", cos), ("f", f)):
             rec(tag + name, value)

@@ -12,13 +12,15 @@ from __future__ import annotations
 import ctypes
 import importlib.util
 import os
-from ctypes import POINTER, Structure, c_double, c_int32, c_int64, c_uint64, c_void_p
+from ctypes import POINTER, Structure, c_double, c_int32, c_int64, c_uint64, c_void_p, cast, pointer
 from functools import lru_cache
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import Rend3rError
+from ..precision.formats import FloatFormat, parse
+from ..precision.stages import STAGES
 
 if TYPE_CHECKING:
     from .arith import Arith
@@ -41,14 +43,26 @@ class Format(Structure):
     """A working format of the _fmt kernels (csrc/fformat.h)."""
 
     _fields_ = [("drop", c_int64), ("max_bits", c_uint64), ("min_normal_bits", c_uint64),
-                ("subnormal_magic", c_double), ("ftz", c_int32), ("wide", c_int32), ("before", c_int32)]
+                ("subnormal_magic", c_double), ("ftz", c_int32), ("wide", c_int32), ("before", c_int32),
+                ("stages", c_int32)]
 
     @classmethod
-    def of(cls, ar: Arith) -> Format:
-        fmt, bits = ar.format, lambda x: int(np.float64(x).view(np.uint64))  # noqa: E731
+    def of(cls, ar: Arith):
+        """The kernels' format argument: one Format, or for a per-stage map the load format
+        (exact float16) and one per stage, in STAGES order (csrc/fformat.h)."""
+        if not ar.stages:
+            return pointer(cls._one(ar.format, ar.tininess))
+        formats = [parse("e5m10", "ieee"), *(ar.stage_formats.get(s, ar.format) for s in STAGES)]
+        table = (cls * len(formats))(*(cls._one(f, ar.tininess) for f in formats))
+        table[0].stages = len(STAGES)
+        return cast(table, POINTER(cls))  # the pointer keeps the table alive
+
+    @classmethod
+    def _one(cls, fmt: FloatFormat, tininess: str) -> Format:
+        bits = lambda x: int(np.float64(x).view(np.uint64))  # noqa: E731
         return cls(52 - fmt.frac_bits, bits(fmt.max), bits(fmt.min_normal),
                    float(np.ldexp(1.0, fmt.emin - fmt.frac_bits + 52)), int(fmt.ftz),
-                   int(fmt.frac_bits > 25 or fmt.exp_bits == 11), int(ar.tininess == "before"))
+                   int(fmt.frac_bits > 25 or fmt.exp_bits == 11), int(tininess == "before"), 0)
 
 
 class Shapes(Structure):

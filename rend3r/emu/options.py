@@ -22,6 +22,7 @@ class EmuOptions:
     """How to run a program and render its frames."""
 
     precision: Precision = "fp16"
+    stage_precision: tuple[tuple[str, Precision], ...] = ()  # per-stage formats (rend3r.precision.stages)
     subnormals: Literal["ftz", "ieee"] = "ftz"
     tininess: Literal["after", "before"] = "after"  # ftz: tiny judged after rounding, or before (a quirk)
     mode: Mode = "raytrace"
@@ -47,7 +48,7 @@ class EmuOptions:
 
     @property
     def arith(self) -> Arith:
-        return make_arith(self.precision, self.subnormals, self.tininess)
+        return make_arith(self.precision, self.subnormals, self.tininess, self.stage_precision)
 
     @property
     def pixels(self) -> int:

@@ -124,7 +124,7 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     cam[native.CAM_TMIN], cam[native.CAM_TMAX], cam[native.CAM_Z] = rays.tmin, rays.tmax, rays.z
     if rays.rotation is not None:  # the kernel turns (x[col], y[row], z) per pixel
         cam[native.CAM_ROT:native.CAM_ROT + 4] = [np.asarray(c, dtype) for c in rays.rotation]
-    fmt = None if ar.native else pointer(native.Format.of(ar))
+    fmt = None if ar.native else native.Format.of(ar)
     sf, si, bnd, bounded, index = _shape_tables(scene, ar, fmt)
     lights = lights_from_scene(scene, ar, options.light_model)
     n = len(sf)
@@ -149,7 +149,8 @@ def _shape_tables(scene: Scene, ar: Arith, fmt) -> tuple[np.ndarray, ...]:
     (floats, ints, bounds, bounded, program index), in index order. Shapes are bounded
     (culled, csrc/bounds.h) in fp16, fp32, fp64 and formats with fp32's exponent range or
     wider, whose products of scene values cannot overflow, as section 7 of
-    docs/emulator.md assumes; in narrower formats every ray tests every shape."""
+    docs/emulator.md assumes (with per-stage formats: every stage's, the bounds taking the
+    arith's staged unit roundoff); in narrower formats every ray tests every shape."""
     table = scene.objects
     values = np.ascontiguousarray(table.values, np.uint16)
     index = np.ascontiguousarray(table.index, np.int64)
@@ -162,7 +163,7 @@ def _shape_tables(scene: Scene, ar: Arith, fmt) -> tuple[np.ndarray, ...]:
     n = native.kernel("shape_tables", ar)(
         native.ptr(values, np.uint16, (rows, PROP_LIMIT)), index.ctypes.data, rows, _SHAPE_PROPS.ctypes.data,
         _KINDS.ctypes.data, sf.ctypes.data, si.ctypes.data, bnd.ctypes.data, bounded.ctypes.data, out.ctypes.data, fmt)
-    if not (ar.precision in PRECISIONS or ar.format.exp_bits >= 8):
+    if not ((not ar.stages and ar.precision in PRECISIONS) or ar.exp_bits >= 8):
         bounded[:] = 0
     return sf[:n], si[:n], bnd[:n], bounded[:n].astype(bool), out[:n]
 

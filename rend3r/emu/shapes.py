@@ -159,12 +159,9 @@ def solve(ar: Arith, s: Shapes | Form, S: Vec, D: Vec, c2: np.ndarray, tmin: np.
         a2 = direction_term(ar, s, D)
     ds = ar.add(ar.add(ar.mul(D[0], S[0]), ar.mul(D[1], S[1])), _zterm(s, ar.mul(D[2], S[2])))
     b = ar.add(ds, ds)
-    disc = ar.sub(ar.mul(b, b), ar.mul(a2, c2))
+    disc = discriminant(ar, b, a2, c2)
     real = disc >= 0
-    root = ar.sqrt(np.where(real, disc, np.zeros((), disc.dtype)))
-    nb = ar.neg(b)
-    t1 = ar.div(ar.sub(nb, root), a2)
-    t2 = ar.div(ar.add(nb, root), a2)
+    root, t1, t2 = roots(ar, b, np.where(real, disc, np.zeros((), disc.dtype)), a2)
     # disc = b*b - a2*c2 is finite exactly when a2, b, c2 and disc all are (an infinite or
     # NaN input makes a product infinite or NaN, and the difference with it)
     bad = ~np.isfinite(disc) | (real & ~_finite(t1, t2))
@@ -179,6 +176,18 @@ def solve(ar: Arith, s: Shapes | Form, S: Vec, D: Vec, c2: np.ndarray, tmin: np.
         hit &= t <= tmax
     hit &= ~bad
     return Solution(hit, t, bad, a2, b, disc, root, t1, t2)
+
+
+def discriminant(ar: Arith, b: np.ndarray, a2: np.ndarray, c2: np.ndarray) -> np.ndarray:
+    """b*b - a2*c2 (its own stage, rend3r.precision.stages)."""
+    return ar.sub(ar.mul(b, b), ar.mul(a2, c2))
+
+
+def roots(ar: Arith, b: np.ndarray, disc: np.ndarray, a2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """sqrt(disc) (disc made 0 where negative by the caller), (-b - root)/a2, (-b + root)/a2."""
+    root = ar.sqrt(disc)
+    nb = ar.neg(b)
+    return root, ar.div(ar.sub(nb, root), a2), ar.div(ar.add(nb, root), a2)
 
 
 def transform_classes(s: Shapes) -> tuple[np.ndarray, np.ndarray]:

@@ -12,10 +12,12 @@ from __future__ import annotations
 import json
 import math
 import re
+from dataclasses import replace
 from typing import Callable, Iterable
 
 import numpy as np
 
+from ..precision.stages import VALUE_STAGES
 from .arith import Arith
 from .options import EmuOptions
 from .scene import Scene
@@ -23,9 +25,10 @@ from .scene import Scene
 Emit = Callable[[dict], None]
 
 
-def encode_value(ar: Arith, value: float) -> tuple[str, float | str]:
-    """(hex bits in the working format, decimal) of one working-precision value."""
-    bits, digits = ar.bits(value)
+def encode_value(ar: Arith, value: float, stage: str | None = None) -> tuple[str, float | str]:
+    """(hex bits in the format of its stage, the working format for None; decimal) of one
+    working-precision value."""
+    bits, digits = ar.bits(value, stage)
     v = float(value)
     dec: float | str = v if math.isfinite(v) else ("nan" if math.isnan(v) else ("inf" if v > 0 else "-inf"))
     return f"0x{bits:0{digits}x}", dec
@@ -42,8 +45,13 @@ class _Writer:
         self.ar, self.emit, self.frame, self.pixel = ar, emit, frame, pixel
 
     def put(self, stage: str, value, shape: int | None, integer: bool = False) -> None:
-        hx, dec = _int_record(int(value)) if integer else encode_value(self.ar, value)
+        hx, dec = _int_record(int(value)) if integer else encode_value(self.ar, value, _value_stage(self.ar, stage))
         self.emit({"frame": self.frame, "pixel": list(self.pixel), "shape": shape, "stage": stage, "hex": hx, "dec": dec})
+
+
+def _value_stage(ar: Arith, name: str) -> str | None:
+    """The datapath stage of a traced value (per-stage maps; raster values: the base)."""
+    return VALUE_STAGES.get(name.split(".", 1)[1] if name.startswith("L") else name) if ar.stages else None
 
 
 _PIXEL = re.compile(r"\s*(-?[0-9]{1,9})\s*,\s*(-?[0-9]{1,9})\s*", re.ASCII)
@@ -107,7 +115,7 @@ def trace_raster(scene: Scene, options: EmuOptions, frame: int, pixels: Iterable
     from .raster_clip import clip_triangles
     from .raster_shade import flat_colours
 
-    ar = options.arith
+    ar = replace(options.arith, stages=())  # the rasterizer works in the base precision
     index, tris, colours = triangles_from_scene(scene, ar, options.raster_next_triangle)
     lights = lights_from_scene(scene, ar, options.light_model)
     view = frame_view(scene, options)

@@ -50,12 +50,15 @@ class Score:
 
 def render_design(program: ProgramSpec, precision: str, subnormals: str, width: int, height: int,
                   jobs: int = 0) -> Rendering:
-    """Render ``program`` with ``precision`` as the working format of every operation."""
+    """Render ``program`` in the design ``precision``: a working format for every operation,
+    or a base format with formats per stage (:func:`.search.split_design`)."""
     from ..emu import EmuOptions, run_program
     from ..errors import Rend3rError
+    from .search import split_design
 
-    options = EmuOptions(precision=precision, subnormals=subnormals, mode=program.mode, width=width,  # type: ignore[arg-type]
-                         height=height, jobs=jobs)
+    base, stages = split_design(precision)
+    options = EmuOptions(precision=base, stage_precision=stages, subnormals=subnormals, mode=program.mode,  # type: ignore[arg-type]
+                         width=width, height=height, jobs=jobs)
     frames = run_program(list(program.words), options=options, frames=program.frames).frames
     if not frames:
         raise Rend3rError(f"{program.name}: rendered no frame (no nf before the program ends)")
@@ -85,13 +88,16 @@ def render_and_score(program: ProgramSpec, precision: str, reference: Rendering,
 
 
 def design_cost(precision: str) -> Resources:
-    """Modelled cost of a device whose raytrace and raster datapaths both work in ``precision``
-    (:mod:`rend3r.precision.datapath` counts, :mod:`rend3r.precision.cost` per unit)."""
+    """Modelled cost of a device whose raytrace and raster datapaths both work in the design
+    ``precision``'s base format, each raytrace stage of its map in that stage's format
+    (:mod:`rend3r.precision.datapath` counts per stage, :mod:`rend3r.precision.cost` per unit)."""
     from ..precision.datapath import raster_counts, raytrace_counts
     from ..precision.formats import parse
+    from .search import split_design
 
-    fmt = parse(precision)
-    return raytrace_counts().cost(fmt) + raster_counts().cost(fmt)
+    base, stages = split_design(precision)
+    fmt = parse(base)
+    return raytrace_counts().cost(fmt, {s: parse(p) for s, p in stages}) + raster_counts().cost(fmt)
 
 
 def cheapest(scores: dict[str, Score], costs: dict[str, Resources], min_psnr: float) -> str | None:

@@ -1,5 +1,6 @@
-"""``rend3r explore``: render programs in several uniform formats, score them against fp64,
-cost each format, and write ``results.csv``, ``pareto.svg`` and ``summary.md``."""
+"""``rend3r explore``: render programs in several designs (uniform formats, or formats per
+stage), or search per-stage formats greedily (``--search``); score against fp64, cost each
+design, and write ``results.csv``, ``pareto.svg`` and ``summary.md``."""
 
 from __future__ import annotations
 
@@ -17,22 +18,27 @@ from ..errors import Rend3rError
 from ..progress import Progress, quiet_option
 
 if TYPE_CHECKING:
-    from .campaign import ProgramSpec
+    from .campaign import ProgramSpec, Score
 
 DEFAULT_FORMATS = "fp16,bf16,tf32,fp24,fp32"
+#: --search's default ladder, each format cheaper in every operator than the one before, all
+#: with fp32's exponent range (so every design is culled: docs/precision.md section 7).
+DEFAULT_LADDER = "fp32,e8m16,e8m13,tf32"
 
 
 def parse_formats(ctx: click.Context, param: click.Parameter, value: str) -> list[str]:
-    """Comma-separated format names, each checked (a bad one exits 2); repeats of a format dropped."""
-    from ..emu.arith import precision_name
+    """Comma-separated designs (a format, or ``BASE:STAGE=FORMAT+...``), each checked (a bad
+    one exits 2); repeats of a design dropped."""
+    from .search import design_name, split_design
 
-    names: dict[str, str] = {}  # canonical name -> the name as given (bf16 rather than e8m7)
+    names: dict[tuple, str] = {}  # canonical design -> the name as given (bf16 rather than e8m7)
     for text in value.split(","):
         try:
-            name = precision_name(text.strip())
+            base, stages = split_design(text.strip().lower())
         except ValueError as exc:
             raise click.BadParameter(str(exc), ctx, param) from None
-        names.setdefault(name, text.strip().lower())
+        shown = text.strip().lower()
+        names.setdefault((base, stages), shown if not stages else design_name(shown.partition(":")[0], dict(stages)))
     return list(names.values())
 
 
@@ -55,7 +61,13 @@ def load_spec(path: Path):
 @click.option("-o", "--output", "out_dir", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="Folder for results.csv, pareto.svg and summary.md (made if missing).")
 @click.option("--formats", default=DEFAULT_FORMATS, show_default=True, callback=parse_formats, metavar="LIST",
-              help="Comma-separated working formats: fp16, bf16, tf32, fp24, fp32, fp64 or any eEmM.")
+              help="Comma-separated designs: a working format (fp16, bf16, tf32, fp24, fp32, fp64 or any eEmM), or "
+                   "a base with formats per stage, BASE:STAGE=FORMAT+STAGE=FORMAT (fp32:sqrt=fp16+hit=bf16).")
+@click.option("--search", is_flag=True,
+              help="Greedy per-stage narrowing down --ladder while every program keeps --min-psnr "
+                   "(instead of --formats; docs/precision.md section 7).")
+@click.option("--ladder", default=DEFAULT_LADDER, show_default=True, callback=parse_formats, metavar="LIST",
+              help="--search: the formats a stage may take, widest first, each cheaper than the one before.")
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True,
               help="Subnormal handling of every format (fp32 and fp64 keep theirs).")
 @click.option("--size", type=SIZE, default="256x192", show_default=True, help="Image size (1..8192 each).")
@@ -65,9 +77,9 @@ def load_spec(path: Path):
 @SCHEDULER
 @MAX_MEMORY
 @quiet_option
-def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str], subnormals: str,
-                    size: tuple[int, int], min_psnr: float, jobs: int, scheduler: str, max_memory: int | None,
-                    quiet: bool) -> None:
+def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str], search: bool, ladder: list[str],
+                    subnormals: str, size: tuple[int, int], min_psnr: float, jobs: int, scheduler: str,
+                    max_memory: int | None, quiet: bool) -> None:
     """Which uniform number format each PROGRAM needs, and what each format costs.
 
     Renders every program in every format of LIST and in fp64, scores each against
@@ -80,42 +92,78 @@ def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str
     all or nothing. The renders run as independent tasks on --scheduler
     (docs/campaigns.md); the results do not depend on where they ran.
 
+    With --search, the designs are found instead of given: every stage of the raytrace
+    datapath, and the base format the rasterizer works in, starts at the ladder's first
+    format, and round by round the part whose narrowing saves the most LUTs per dB of
+    worst PSNR lost (every program staying at --min-psnr) narrows one rung, until none
+    can; summary.md shows the path and per program the cheapest design visited that
+    meets the bound.
+
     \b
     Example:
       rend3r explore programs/*.asm -o out/explore
       rend3r explore programs/shadow.asm -o out/e --formats e4m3,bf16,e6m9 --size 64x48
+      rend3r explore programs/*.asm -o out/s --search --min-psnr 40 --size 64x48
       rend3r explore programs/*.asm -o out/explore --scheduler tcp://10.0.0.5:8786
     """
     from ..campaign.runner import Campaign
     from ..fileio import Outputs
     from .campaign import REFERENCE, design_cost, render_and_score, render_design
     from .report import Results, pareto_svg, results_csv, summary_md
+    from .search import check_ladder, greedy, search_summary
 
     width, height = size
+    ctx = click.get_current_context()
+    if search and ctx.get_parameter_source("formats") is not click.core.ParameterSource.DEFAULT:
+        raise click.UsageError("--search finds the designs: give --ladder, not --formats")
+    if search:
+        try:
+            check_ladder(ladder, design_cost)
+        except ValueError as exc:
+            raise click.BadParameter(str(exc), ctx, param_hint="--ladder") from None
     with Outputs() as out:
         files = {name: out.reserve(out_dir / name) for name in ("results.csv", "pareto.svg", "summary.md")}
         specs = [load_spec(p) for p in programs]
         if len({s.name for s in specs}) != len(specs):
             raise click.UsageError("two programs have the same name; results.csv keys rows by name")
         _check_memory(specs, width, height, scheduler, max_memory or default_memory())
-        costs = {f: design_cost(f) for f in formats}
         options = {"subnormals": subnormals, "width": width, "height": height, "jobs": jobs}
-        pairs = [(spec, f) for spec in specs for f in formats]
-        with Campaign(scheduler) as campaign, Progress(len(specs) + len(pairs), "explore", quiet=quiet) as bar:
-            references = campaign.map(partial(render_design, precision=REFERENCE, **options), [(s,) for s in specs],
-                                      [f"{s.name} in {REFERENCE}" for s in specs], bar)
+        scores: dict[tuple[str, str], Score] = {}
+        with Campaign(scheduler) as campaign:
+            with Progress(len(specs), "explore: fp64", quiet=quiet) as bar:
+                references = campaign.map(partial(render_design, precision=REFERENCE, **options),
+                                          [(s,) for s in specs], [f"{s.name} in {REFERENCE}" for s in specs], bar)
             reference = {s.name: r for s, r in zip(specs, references)}
-            found = campaign.map(partial(render_and_score, **options), [(s, f, reference[s.name]) for s, f in pairs],
-                                 [f"{s.name} in {f}" for s, f in pairs], bar)
-        scores = {(s.name, f): score for (s, f), score in zip(pairs, found)}
-        results = Results(specs, formats, scores, costs, min_psnr, subnormals, size)
+
+            def evaluate(designs: list[str]) -> dict[str, list[Score]]:
+                """Every program in every design not scored yet; the scores of ``designs``."""
+                pairs = [(s, d) for d in dict.fromkeys(designs) for s in specs if (s.name, d) not in scores]
+                with Progress(len(pairs), "explore", quiet=quiet) as bar:
+                    found = campaign.map(partial(render_and_score, **options),
+                                         [(s, d, reference[s.name]) for s, d in pairs],
+                                         [f"{s.name} in {d}" for s, d in pairs], bar)
+                scores.update(((s.name, d), score) for (s, d), score in zip(pairs, found))
+                return {d: [scores[s.name, d] for s in specs] for d in designs}
+
+            if search:
+                evaluate(ladder)  # the uniform rungs, for comparison
+                path = greedy(ladder, min_psnr, evaluate, design_cost)
+            else:
+                evaluate(formats)
+        designs = list(dict.fromkeys(d for _, d in scores))
+        costs = {d: design_cost(d) for d in designs}
+        results = Results(specs, designs, scores, costs, min_psnr, subnormals, size)
         command = "rend3r " + shlex.join(sys.argv[1:]) if sys.argv[1:2] == ["explore"] else "rend3r explore ..."
+        if search:
+            summary = search_summary(path, results, ladder, command)
+        else:
+            summary = summary_md(results, command)
         out.write(files["results.csv"], results_csv(results))
         out.write(files["pareto.svg"], pareto_svg(results))
-        out.write(files["summary.md"], summary_md(results, command))
+        out.write(files["summary.md"], summary)
         out.commit()
     if not quiet:
-        click.echo(f"explore: {len(specs)} program(s) x {len(formats)} format(s) at {width}x{height} -> {out_dir}")
+        click.echo(f"explore: {len(specs)} program(s) x {len(designs)} design(s) at {width}x{height} -> {out_dir}")
 
 
 def _check_memory(specs: list[ProgramSpec], width: int, height: int, scheduler: str, budget: int) -> None:

@@ -12,6 +12,8 @@ from xml.sax.saxutils import escape
 from ..precision.datapath import Resources
 from .campaign import ProgramSpec, Score, cheapest, worst_psnr
 
+#: Above this many designs, pareto.svg names only the front's points (each point's name is its tooltip).
+MAX_LABELS = 12
 COLUMNS = ("program", "mode", "frames", "format", "subnormals", "psnr_db", "max_channel", "differing_share",
            "provenance_share", "interior_provenance_share", "lut", "ff", "dsp", "meets_min_psnr")
 
@@ -35,7 +37,7 @@ class Results:
         return {f: self.scores[program.name, f] for f in self.formats}
 
 
-def _db(value: float) -> str:
+def decibels(value: float) -> str:
     return "inf" if math.isinf(value) else f"{value:.2f}"
 
 
@@ -47,7 +49,7 @@ def results_csv(r: Results) -> bytes:
     for p in r.programs:
         for f in r.formats:
             s, c = r.scores[p.name, f], r.costs[f]
-            w.writerow([p.name, p.mode, p.frames, f, r.subnormals, _db(s.psnr), s.max_channel, f"{s.differing:.6f}",
+            w.writerow([p.name, p.mode, p.frames, f, r.subnormals, decibels(s.psnr), s.max_channel, f"{s.differing:.6f}",
                         f"{s.provenance:.6f}", f"{s.interior_provenance:.6f}", c.lut, c.ff, c.dsp,
                         int(s.psnr >= r.min_psnr)])
     return out.getvalue().encode()
@@ -102,35 +104,43 @@ def pareto_svg(r: Results) -> bytes:
     front = pareto_front(points)
     line = " ".join(f"{x(points[f][0].lut):.1f},{y(points[f][1]):.1f}" for f in front)
     parts.append(f'<polyline points="{line}" fill="none" stroke="steelblue" stroke-width="2"/>')
+    labelled = set(front) if len(points) > MAX_LABELS else set(points)  # a search's many designs: the front's
     for f, (c, psnr) in points.items():
         colour = "steelblue" if f in front else "grey"
-        parts.append(f'<circle cx="{x(c.lut):.1f}" cy="{y(psnr):.1f}" r="4" fill="{colour}"/>')
-        parts.append(f'<text x="{x(c.lut) + 6:.1f}" y="{y(psnr) - 6:.1f}">{escape(f)}</text>')
+        parts.append(f'<circle cx="{x(c.lut):.1f}" cy="{y(psnr):.1f}" r="4" fill="{colour}"><title>{escape(f)}'
+                     '</title></circle>')
+        if f in labelled:
+            parts.append(f'<text x="{x(c.lut) + 6:.1f}" y="{y(psnr) - 6:.1f}">{escape(f)}</text>')
     parts.append("</svg>\n")
     return "\n".join(parts).encode()
 
 
+def summary_header(r: Results, title: str, command: str, conditions: str) -> list[str]:
+    """The opening lines of a summary.md: title, command, size, subnormals and ``conditions``."""
+    w, h = r.size
+    return [f"# {title}", "", f"`{command}`", "", f"{w}x{h}, subnormals {r.subnormals}, scored against fp64; {conditions}",
+            ""]
+
+
 def summary_md(r: Results, command: str) -> bytes:
     """Per program the cheapest format meeting the bound, then per format its cost."""
-    w, h = r.size
-    lines = [f"# rend3r explore: {len(r.programs)} program(s) x {len(r.formats)} format(s)", "",
-             f"`{command}`", "",
-             (f"{w}x{h}, subnormals {r.subnormals}, scored against fp64; a format meets the bound when its PSNR "
-             f"is at least {r.min_psnr:g} dB. Cost: the raytrace and raster datapaths' units "
-             "(`rend3r.precision.datapath`) times each unit's modelled cost (`rend3r.precision.cost`); "
-             "the cheapest is the one with fewest LUTs."), "",
+    title = f"rend3r explore: {len(r.programs)} program(s) x {len(r.formats)} format(s)"
+    conditions = (f"a format meets the bound when its PSNR is at least {r.min_psnr:g} dB. Cost: the raytrace and "
+                  "raster datapaths' units (`rend3r.precision.datapath`) times each unit's modelled cost "
+                  "(`rend3r.precision.cost`); the cheapest is the one with fewest LUTs.")
+    lines = [*summary_header(r, title, command, conditions),
              "| program | mode | cheapest meeting the bound | " + " | ".join(f"{f} PSNR" for f in r.formats) + " |",
              "|---|---|---|" + "---:|" * len(r.formats)]
     for p in r.programs:
         by_format = r.of_program(p)
         best = cheapest(by_format, r.costs, r.min_psnr)
         lines.append(f"| {p.name} | {p.mode} | {best or 'none'} | "
-                     + " | ".join(_db(by_format[f].psnr) for f in r.formats) + " |")
+                     + " | ".join(decibels(by_format[f].psnr) for f in r.formats) + " |")
     lines += ["", "| format | LUT | FF | DSP48E1 | worst PSNR (dB) | programs meeting the bound |",
               "|---|---:|---:|---:|---:|---:|"]
     for f in r.formats:
         c, scores = r.costs[f], r.of_format(f)
         meeting = sum(s.psnr >= r.min_psnr for s in scores)
-        lines.append(f"| {f} | {c.lut:,} | {c.ff:,} | {c.dsp:,} | {_db(worst_psnr(scores))} | "
+        lines.append(f"| {f} | {c.lut:,} | {c.ff:,} | {c.dsp:,} | {decibels(worst_psnr(scores))} | "
                      f"{meeting}/{len(scores)} |")
     return ("\n".join(lines) + "\n").encode()

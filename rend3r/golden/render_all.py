@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import click
 
 from ..campaign.options import SCHEDULER
-from ..cliutil import JOBS, PRECISION, SIZE
+from ..cliutil import JOBS, PRECISION, SIZE, STAGE_PRECISION
 from ..errors import Rend3rError
 from ..progress import Progress, ProgressFactory, hidden, quiet_option
 from .catalog import ExampleProgram, program_paths, read_header
@@ -133,12 +133,14 @@ def render_all(programs_dir: Path, out_dir: Path, options: EmuOptions, scheduler
 @click.option("-o", "--output", "out_dir", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="Folder for the PNGs (made if missing).")
 @PRECISION
+@STAGE_PRECISION
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True, help="fp16 subnormal handling.")
 @click.option("--size", type=SIZE, default="512x384", show_default=True, help="Image size (1..8192 each).")
 @JOBS
 @SCHEDULER
 @quiet_option
-def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnormals: str, size: tuple[int, int],
+def render_all_command(programs_dir: Path, out_dir: Path, precision: str,
+                       stage_precision: tuple[tuple[str, str], ...] | None, subnormals: str, size: tuple[int, int],
                        jobs: int, scheduler: str, quiet: bool) -> None:
     """Render every PROGRAMS_DIR/*.asm (default: programs) to PNGs in folder DIR.
 
@@ -159,7 +161,8 @@ def render_all_command(programs_dir: Path, out_dir: Path, precision: str, subnor
     if not programs_dir.is_dir():
         raise Rend3rError(f"{programs_dir} is not a folder")
     width, height = size
-    options = EmuOptions(precision=precision, subnormals=subnormals, width=width, height=height, jobs=jobs)
+    options = EmuOptions(precision=precision, stage_precision=stage_precision or (), subnormals=subnormals,
+                         width=width, height=height, jobs=jobs)
     failed = render_all(programs_dir, out_dir, options, scheduler, echo=click.echo,
                         progress=partial(Progress, quiet=quiet))
     if failed:

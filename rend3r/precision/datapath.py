@@ -6,7 +6,10 @@ call on arrays is one hardware unit of a fully pipelined datapath (every operati
 ``docs/emulator.md`` section 4 its own adder, multiplier, divider or square root), so the
 counts are the units such a datapath instantiates: for the raytracer, one ray against one
 shape, then per light the lighting and one shadow test; for the rasterizer, one
-triangle's set-up and one pixel. A datapath that shares units between steps needs fewer. Rotations use a quaternion that is not the identity, so the
+triangle's set-up and one pixel. Raytracer units are counted per stage of
+:data:`rend3r.precision.stages.STAGES` (the table the staged arithmetic reads, so a
+design with a format per stage is costed stage by stage; a shadow test's units are in
+the transform to square-root stages, as in the kernels); the rasterizer's per function. A datapath that shares units between steps needs fewer. Rotations use a quaternion that is not the identity, so the
 emulator's identity short cut (``vec.rotate_inverse``) does not skip their units;
 negation (a sign flip) and comparisons are not counted.
 """
@@ -15,6 +18,7 @@ from __future__ import annotations
 
 import sys
 from collections import Counter
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cache
 from types import FrameType
@@ -24,6 +28,7 @@ import numpy as np
 
 from .cost import operator_cost
 from .formats import FloatFormat
+from .stages import current_stage
 
 if TYPE_CHECKING:
     from ..emu.options import Mode
@@ -32,14 +37,6 @@ if TYPE_CHECKING:
 #: (subtraction is counted as an adder).
 COUNTED = ("add", "mul", "div", "sqrt")
 
-#: Raytracer stages: the emulator function a call is made in -> stage name. A call inside
-#: a shadow test or the lighting belongs there, whatever it calls.
-_RAY_STAGES = {
-    "camera_rays": "camera", "direction": "camera", "to_object": "intersect", "origin_term": "intersect", "solve": "intersect",
-    "squared_distance": "distance", "render_reference": "distance",  # |d|^2 is computed in the caller
-    "surface": "surface", "diffuse": "lighting", "_blocked": "shadow",
-}
-_OUTER = ("_blocked", "diffuse")  # stages that contain calls of others
 
 _RAY_SCENE = """
 nr
@@ -105,9 +102,12 @@ class OperationCounts:
     total: dict[str, int]
     stages: dict[str, dict[str, int]]
 
-    def cost(self, fmt: FloatFormat) -> Resources:
-        """The datapath's units in ``fmt``: each unit's modelled LUT, FF and DSP, summed."""
-        parts = [(n, operator_cost(op, fmt)) for op, n in self.total.items()]
+    def cost(self, fmt: FloatFormat, stages: Mapping[str, FloatFormat] | None = None) -> Resources:
+        """The datapath's units in ``fmt``, those of a stage in ``stages`` in its format: each
+        unit's modelled LUT, FF and DSP, summed."""
+        formats = stages or {}
+        parts = [(n, operator_cost(op, formats.get(stage, fmt)))
+                 for stage, ops in self.stages.items() for op, n in ops.items()]
         return Resources(*(sum(n * getattr(c, f) for n, c in parts) for f in ("lut", "ff", "dsp")))
 
 
@@ -146,22 +146,21 @@ def _counting_arith():
 
 
 def _stage() -> str:
-    """The stage of the datapath the current Arith call is made in: the outer stage
-    (shadow, lighting) if the call is inside one, else the innermost named function of
-    :data:`_RAY_STAGES`, else the innermost function of the rasterizer's modules."""
-    frame: FrameType | None = sys._getframe(3)  # the caller of the counting method's caller
-    inner, raster = None, None
+    """The stage of the datapath the current Arith call is made in: its raytrace stage
+    (:func:`~rend3r.precision.stages.current_stage`), else the innermost function of the
+    rasterizer's modules."""
+    stage = current_stage(3)  # from the counting method up
+    if stage is not None:
+        return stage
+    frame: FrameType | None = sys._getframe(3)
     while frame is not None:
         name = frame.f_code.co_name
-        if name in _OUTER:
-            return _RAY_STAGES[name]
-        if inner is None and name in _RAY_STAGES:
-            inner = _RAY_STAGES[name]
-        module = frame.f_globals.get("__name__", "")
-        if raster is None and module.startswith("rend3r.emu.raster") and not name.startswith("<"):
-            raster = name.lstrip("_")
+        if name == "diffuse":  # the lighting the raytracer shares
+            return "lighting"
+        if frame.f_globals.get("__name__", "").startswith("rend3r.emu.raster") and not name.startswith("<"):
+            return name.lstrip("_")
         frame = frame.f_back
-    return inner or raster or "scene"
+    return "scene"
 
 
 def _scene(source: str):

@@ -17,10 +17,12 @@ def test_ray_shape_test_counts_as_the_hand_count():
     #    c2 = 2((Sx^2 + Sy^2) + (Sz^2 - 1))           3 mul  4 add
     # 5. disc = b*b - a2*c2                           2 mul  1 add
     #    root, t1 = (-b - root)/a2, t2 = (-b + root)/a2   1 sqrt  2 add  2 div
-    hand = {"add": 3 + 34 + 3 + 3 + 4 + 1 + 2, "mul": 48 + 6 + 3 + 3 + 3 + 2, "div": 2, "sqrt": 1}
+    # per stage, the primary ray's test and the shadow ray's (one shadow ray against one shape: the same test)
+    hand = {"transform": {"add": 3 + 34, "mul": 48 + 6}, "quadratic": {"add": 3 + 3 + 4, "mul": 3 + 3 + 3},
+            "discriminant": {"add": 1, "mul": 2}, "sqrt": {"add": 2, "div": 2, "sqrt": 1}}
     counts = raytrace_counts()
-    assert counts.stages["intersect"] == hand
-    assert counts.stages["shadow"] == hand  # one shadow ray against one shape: the same test
+    for stage, ops in hand.items():
+        assert counts.stages[stage] == {op: 2 * n for op, n in ops.items()}, stage
 
 
 def test_distance_surface_and_lighting_counts():
@@ -28,10 +30,12 @@ def test_distance_surface_and_lighting_counts():
     # 7. sq_dist = ((dx*dx + dy*dy) + dz*dz) * (t*t)
     assert s["distance"] == {"add": 2, "mul": 5}
     # 8. hit point and object point: 3 mul 3 add each; normal scaled (3 mul), rotated (24 mul 17 add)
-    assert s["surface"] == {"add": 23, "mul": 33}
-    # section 5: l = light - point (3), n.n and l.l and n.l (3 dots), 2 sqrt, denominator, cos, f
-    assert s["lighting"] == {"add": 3 + 6, "mul": 9 + 2, "div": 1, "sqrt": 2}
-    assert raster_counts().stages["lighting"] == s["lighting"]
+    assert s["hit"] == {"add": 23, "mul": 33}
+    # section 5: l = light - point (3), n.n and l.l and n.l (3 dots), 2 sqrt, denominator, cos; f (colour)
+    assert s["lighting"] == {"add": 3 + 6, "mul": 9 + 1, "div": 1, "sqrt": 2}
+    assert s["colour"] == {"mul": 1}
+    raster = raster_counts().stages["lighting"]
+    assert raster == {op: s["lighting"].get(op, 0) + s["colour"].get(op, 0) for op in raster}
 
 
 def test_camera_rotation_is_counted():
@@ -50,3 +54,12 @@ def test_totals_sum_the_stages_and_cost_sums_the_units():
     assert counts.cost(fp16).lut == expected
     assert counts.cost(fp16).dsp == counts.total["mul"]  # one DSP48E1 per fp16 multiplier
     assert counts.cost(parse("fp32")).lut > counts.cost(fp16).lut > counts.cost(parse("e4m3")).lut
+
+
+def test_staged_cost_prices_each_stage_in_its_format():
+    counts, fp16, fp32 = raytrace_counts(), parse("fp16"), parse("fp32")
+    wide = counts.cost(fp16, {"discriminant": fp32})
+    extra = sum(n * (operator_cost(op, fp32).lut - operator_cost(op, fp16).lut)
+                for op, n in counts.stages["discriminant"].items())
+    assert wide.lut == counts.cost(fp16).lut + extra > counts.cost(fp16).lut
+    assert counts.cost(fp16, {stage: fp32 for stage in counts.stages}) == counts.cost(fp32)

@@ -18,6 +18,12 @@
  *
  * The format is a kernel argument (Shapes.format, shape_tables' last argument): each
  * kernel copies it to a thread-local at entry (FORMAT_ENTER), where R reads it.
+ *
+ * Per-stage formats (rend3r/precision/stages.py): the argument is then an array, the
+ * load format (exact float16: scene values enter unrounded) with `stages` set, then one
+ * format per stage in the order of the enum below; STAGE(k) in datapath.inc makes stage
+ * k's format current, and every operation first rounds its operands to it (the converter
+ * a value crosses between stages; a value already in the format is unchanged).
  */
 #ifndef REND3R_FFORMAT_H
 #define REND3R_FFORMAT_H
@@ -28,9 +34,15 @@
 #include "kernels.h"
 #include "simd.h"
 
-static _Thread_local Format format_now;
+/* The stages, in the order of rend3r/precision/stages.py STAGES (tests/precision/test_stages.py). */
+enum { STAGE_CAMERA, STAGE_TRANSFORM, STAGE_QUADRATIC, STAGE_DISCRIMINANT, STAGE_SQRT, STAGE_DISTANCE, STAGE_HIT,
+       STAGE_LIGHTING, STAGE_COLOUR, STAGE_COUNT };
 
-#define FORMAT_ENTER(f) (format_now = *(f))
+static _Thread_local Format format_now;
+static _Thread_local const Format *format_stages;  /* per-stage map (NULL: one format) */
+
+#define FORMAT_ENTER(f) (format_now = *(f), format_stages = (f)->stages ? (f) : NULL)
+#define FORMAT_STAGE(k) (format_stages != NULL ? (void)(format_now = format_stages[1 + (k)]) : (void)0)
 
 #define F64_SIGN 0x8000000000000000ull
 #define F64_INF 0x7FF0000000000000ull
@@ -39,6 +51,8 @@ static _Thread_local Format format_now;
 static inline f64x4 round_format4(f64x4 x)
 {
     const Format *f = &format_now;
+    if (f->drop == 0)  /* e11m52 (a stage in fp64): double itself */
+        return x;
     u64x4 b = (u64x4)x, a = b & ~F64_SIGN, sign = b & F64_SIGN;
     uint64_t drop = (uint64_t)f->drop, keep = ~((1ull << drop) - 1);
     u64x4 r = (b + ((1ull << drop) >> 1) - 1 + ((b >> drop) & 1)) & keep;  /* nearest even at M bits */
@@ -67,6 +81,8 @@ static inline f64x4 to_odd4(f64x4 d, f64x4 e)
  * format keeps fewer bits and round to odd applies. */
 static inline f64x4 to_side4(f64x4 d, f64x4 e)
 {
+    if (format_now.drop == 0)
+        return d;
     if (format_now.drop > 1)
         return to_odd4(d, e);
     u64x4 b = (u64x4)d, a = b & ~F64_SIGN;
@@ -85,8 +101,13 @@ static inline f64x4 product_error4(f64x4 x, f64x4 y, f64x4 p)
     return ((xh * yh - p) + xh * yl + xl * yh) + xl * yl;
 }
 
+/* Operands into the current stage's format (per-stage maps only). */
+#define CONVERT(x) (format_stages != NULL ? round_format4(x) : (x))
+
 static inline f64x4 format_add4(f64x4 a, f64x4 b)
 {
+    a = CONVERT(a);
+    b = CONVERT(b);
     f64x4 d = a + b;
     if (format_now.wide) {
         f64x4 bv = d - a;
@@ -97,6 +118,8 @@ static inline f64x4 format_add4(f64x4 a, f64x4 b)
 
 static inline f64x4 format_mul4(f64x4 a, f64x4 b)
 {
+    a = CONVERT(a);
+    b = CONVERT(b);
     f64x4 d = a * b;
     if (format_now.wide)
         d = to_side4(d, product_error4(a, b, d));
@@ -106,6 +129,8 @@ static inline f64x4 format_mul4(f64x4 a, f64x4 b)
 /* a/b = d + r/b with r = a - d*b exact: the error has the sign of r*b. */
 static inline f64x4 format_div4(f64x4 a, f64x4 b)
 {
+    a = CONVERT(a);
+    b = CONVERT(b);
     f64x4 d = a / b;
     if (format_now.wide) {
         f64x4 p = d * b, r = (a - p) - product_error4(d, b, p);
@@ -117,6 +142,7 @@ static inline f64x4 format_div4(f64x4 a, f64x4 b)
 /* sqrt(a) = d + e with e of the sign of a - d*d. */
 static inline f64x4 format_sqrt4(f64x4 a)
 {
+    a = CONVERT(a);
     f64x4 d;
     for (int i = 0; i < 4; i++)
         d[i] = sqrt(a[i]);

@@ -43,6 +43,7 @@ typedef struct {
     int32_t ftz;            /* flush results below 2**emin to zero */
     int32_t wide;           /* M > 25: double rounding is not innocuous, round to odd first */
     int32_t before;         /* ftz judges a result tiny before rounding (a device quirk) */
+    int32_t stages;         /* nonzero: the first of 1 + stages formats of a per-stage map (fformat.h) */
 } Format;
 
 typedef struct {

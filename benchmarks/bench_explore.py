@@ -169,7 +169,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"error: {exc}", file=sys.stderr)
             return 1
     same = remote == here
-    print(f"rend3r explore through {address} (2 worker processes): {remote_s:.1f} s, cluster start included; "
+    print(f"rend3r explore through {address} (2 worker processes): {remote_s:.1f} s for the command; "
           f"results.csv {'identical to' if same else 'DIFFERENT from'} the local campaign's "
           f"({len(here.splitlines()) - 1} rows)")
     return 0 if same else 1

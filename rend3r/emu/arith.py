@@ -154,6 +154,29 @@ class Arith:
             e, m = 0, int(math.ldexp(abs(v), f.frac_bits - f.emin))
         return (int(math.copysign(1, v) < 0) << (f.bits - 1)) | (e << f.frac_bits) | m, -(-f.bits // 4)
 
+    def bits_array(self, values: np.ndarray, stage: str | None = None) -> tuple[np.ndarray, int]:
+        """:meth:`bits` of every value of an array at once: the patterns (uint64, flattened)
+        and their width in hex digits."""
+        precision = self.stage_precision(stage)
+        v = np.asarray(values).reshape(-1)
+        if precision in _NATIVE_BITS:
+            ftype, itype = _NATIVE_BITS[precision]
+            with np.errstate(all="ignore"):
+                return v.astype(ftype).view(itype).astype(np.uint64), np.dtype(itype).itemsize * 2
+        f = self.stage_formats.get(stage or "", self.format)
+        a = np.abs(v.astype(np.float64))
+        with np.errstate(all="ignore"):
+            mant, exp = np.frexp(a)  # a = mant * 2**exp, mant in [0.5, 1)
+            normal = a >= f.min_normal
+            # zero and subnormals: multiples of the least subnormal
+            m = np.where(normal, np.ldexp(mant * 2 - 1, f.frac_bits), np.ldexp(a, f.frac_bits - f.emin))
+        e = np.where(normal, exp - 1 + f.bias, 0)
+        special = ~np.isfinite(a)
+        e[special], m[special] = (1 << f.exp_bits) - 1, 0
+        m[np.isnan(a)] = 1 << (f.frac_bits - 1)
+        sign = np.signbit(v).astype(np.uint64) << np.uint64(f.bits - 1)
+        return sign | (e.astype(np.uint64) << np.uint64(f.frac_bits)) | m.astype(np.uint64), -(-f.bits // 4)
+
     def round(self, x: np.ndarray | float) -> np.ndarray:
         """Round values (already in or above working precision) to the working format (the
         current stage's, when staged)."""

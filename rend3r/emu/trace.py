@@ -13,7 +13,7 @@ import json
 import math
 import re
 from dataclasses import replace
-from typing import Callable, Iterable
+from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -25,28 +25,50 @@ from .scene import Scene
 Emit = Callable[[dict], None]
 
 
-def encode_value(ar: Arith, value: float, stage: str | None = None) -> tuple[str, float | str]:
-    """(hex bits in the format of its stage, the working format for None; decimal) of one
-    working-precision value."""
-    bits, digits = ar.bits(value, stage)
-    v = float(value)
-    dec: float | str = v if math.isfinite(v) else ("nan" if math.isnan(v) else ("inf" if v > 0 else "-inf"))
-    return f"0x{bits:0{digits}x}", dec
+def encode(ar: Arith, values, stage: str | None = None) -> tuple[list[str], list[float | str]]:
+    """(hex bits in the format of ``stage``, the working format for None; decimal) of each
+    working-precision value of an array, all at once."""
+    arr = np.asarray(values).reshape(-1)
+    bits, digits = ar.bits_array(arr, stage)
+    hexes = [f"0x{b:0{digits}x}" for b in bits.tolist()]
+    decs: list[float | str] = arr.astype(np.float64).tolist()
+    for i in np.flatnonzero(~np.isfinite(arr)).tolist():
+        decs[i] = "nan" if math.isnan(decs[i]) else ("inf" if decs[i] > 0 else "-inf")
+    return hexes, decs
 
 
-def _int_record(value: int) -> tuple[str, int]:
-    return (f"-0x{-value:x}" if value < 0 else f"0x{value:x}"), value
+def _int_records(values) -> tuple[list[str], list[int]]:
+    """(signed hex, value) of each integer or flag."""
+    ints = [int(v) for v in values]
+    return [f"-0x{-v:x}" if v < 0 else f"0x{v:x}" for v in ints], ints
 
 
 class _Writer:
-    """Turns (stage, values) into records for one pixel; arrays hold one value per shape."""
+    """Turns (stage, values) into records for one pixel."""
 
     def __init__(self, ar: Arith, emit: Emit, frame: int, pixel: tuple[int, int]) -> None:
         self.ar, self.emit, self.frame, self.pixel = ar, emit, frame, pixel
 
-    def put(self, stage: str, value, shape: int | None, integer: bool = False) -> None:
-        hx, dec = _int_record(int(value)) if integer else encode_value(self.ar, value, _value_stage(self.ar, stage))
+    def column(self, stage: str, values, integer: bool = False) -> tuple[list[str], list]:
+        """(hexes, decimals) of one stage's values (e.g. one per shape)."""
+        return _int_records(values) if integer else encode(self.ar, values, _value_stage(self.ar, stage))
+
+    def rows(self, stages: Sequence[str], columns: Sequence[tuple[list[str], list]], shapes: Sequence[int | None]) -> None:
+        """For each shape in order, a record of each stage: ``columns[k]`` holds stage k's
+        (hexes, decimals), one per shape."""
+        frame, (x, y), emit = self.frame, self.pixel, self.emit
+        for n, shape in enumerate(shapes):
+            for stage, (hexes, decs) in zip(stages, columns):
+                emit({"frame": frame, "pixel": [x, y], "shape": shape, "stage": stage, "hex": hexes[n], "dec": decs[n]})
+
+    def record(self, stage: str, shape: int | None, hx: str, dec) -> None:
+        """One record of an encoded value."""
         self.emit({"frame": self.frame, "pixel": list(self.pixel), "shape": shape, "stage": stage, "hex": hx, "dec": dec})
+
+    def put(self, stage: str, value, shape: int | None, integer: bool = False) -> None:
+        """The record of one value."""
+        (hx,), (dec,) = self.column(stage, [value], integer)
+        self.record(stage, shape, hx, dec)
 
 
 def _value_stage(ar: Arith, name: str) -> str | None:
@@ -81,10 +103,8 @@ def trace_raytrace(scene: Scene, options: EmuOptions, frame: int, pixels: Iterab
     for x, y in pixels:
         w = _Writer(ar, emit, frame, (x, y))
         t = trace_pixel(fr, options, x, y)
-        for slot, values in enumerate(t.shapes):
-            idx = int(fr.index[slot])
-            for stage, value in zip(_SHAPE_STAGES, values):
-                w.put(stage, int(value) if stage == "hit" else value, idx, integer=stage == "hit")
+        columns = [w.column(stage, t.shapes[:, k], integer=stage == "hit") for k, stage in enumerate(_SHAPE_STAGES)]
+        w.rows(_SHAPE_STAGES, columns, fr.index[: len(t.shapes)].tolist())
         winner = int(fr.index[t.nearest]) if t.nearest >= 0 else None
         # A winner whose hit point or lighting is not finite is a miss in the frame
         # (background, provenance -1): nearest says so too; its light stages show why.
@@ -147,11 +167,11 @@ def trace_raster(scene: Scene, options: EmuOptions, frame: int, pixels: Iterable
 def _put_all(w: _Writer, stage: str, values, shape: int | None) -> None:
     """Record a lighting stage (0-d, or one value per traced point; empty: not reached)."""
     arr = np.asarray(values).reshape(-1)
-    integer = arr.dtype.kind in "biu"
-    for v in arr:
-        w.put(stage, int(v) if integer else v, shape, integer=integer)
+    for hx, dec in zip(*w.column(stage, arr, integer=arr.dtype.kind in "biu")):
+        w.record(stage, shape, hx, dec)
 
 
 def jsonl_sink(stream) -> Emit:
     """An Emit that writes one compact JSON object per line to ``stream``."""
-    return lambda record: stream.write(json.dumps(record, separators=(", ", ": ")) + "\n")
+    encode = json.JSONEncoder(separators=(", ", ": ")).encode  # made once: json.dumps makes one per call
+    return lambda record: stream.write(encode(record) + "\n")

@@ -1,14 +1,17 @@
 """Pixel traces: the worked device vectors, agreement with the frame, the JSON schema."""
 
 import io
+import math
 
 import numpy as np
+import pytest
 
+from rend3r.emu.arith import make_arith
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.processor import execute
 from rend3r.emu.raytracer import render_frame
 from rend3r.emu.scene import Scene
-from rend3r.emu.trace import jsonl_sink, trace_raytrace
+from rend3r.emu.trace import encode, jsonl_sink, trace_raytrace
 from rend3r.emu.trace_diff import first_divergence, parse_record
 
 from .scenes import Prog
@@ -89,8 +92,6 @@ def test_records_parse_with_the_diff_reader_and_self_compare_equal():
 
 
 def test_parse_pixel_takes_bounded_decimal_pairs_only():
-    import pytest
-
     from rend3r.emu.trace import parse_pixel
 
     assert parse_pixel(" 252 , 188 ") == (252, 188) and parse_pixel("-1,5") == (-1, 5)
@@ -119,3 +120,35 @@ def test_nearest_is_minus_one_where_lighting_is_not_finite_as_in_the_frame():
     assert _stage(recs, pixel, "colour")["dec"] == int(frame.rgb565[pixel[1], pixel[0]]) == 0
     ieee, _ = render_frame(scene, EmuOptions(width=16, height=12, subnormals="ieee"))
     assert ieee.provenance[pixel[1], pixel[0]] == 0  # with gradual underflow the sphere is lit
+
+
+def _encode_one(ar, value, stage):
+    """The per-value encoding the bulk one replaced: the oracle."""
+    bits, digits = ar.bits(value, stage)
+    v = float(value)
+    dec = v if math.isfinite(v) else ("nan" if math.isnan(v) else ("inf" if v > 0 else "-inf"))
+    return f"0x{bits:0{digits}x}", dec
+
+
+@pytest.mark.parametrize("ar, stage", [
+    (make_arith("fp16"), None), (make_arith("fp16", "ieee"), None), (make_arith("fp32"), None),
+    (make_arith("fp64"), None), (make_arith("e8m7"), None), (make_arith("e4m3", "ieee"), None),
+    (make_arith("e11m40", "ieee"), None),
+    *[(make_arith("fp16", stages=(("quadratic", "e8m7"), ("sqrt", "fp32"), ("hit", "e3m2"))), s)
+      for s in (None, "quadratic", "sqrt", "hit", "lighting")],
+])
+def test_bulk_encoding_equals_the_per_value_one(ar, stage):
+    fmt = ar.stage_formats.get(stage or "", ar.format)
+    rng = np.random.default_rng(7)
+    wide = rng.choice([-1.0, 1.0], 2000) * rng.random(2000) * np.exp2(rng.integers(-1100, 1000, 2000).astype(float))
+    near = np.concatenate([wide, rng.normal(0, 4, 500), rng.random(300) * fmt.min_normal * 3])
+    special = [np.nan, -np.nan, np.inf, -np.inf, 0.0, -0.0, fmt.min_normal, -fmt.min_normal,
+               fmt.min_normal / 2 ** fmt.frac_bits, fmt.max, -fmt.max]
+    with np.errstate(all="ignore"):
+        values = np.concatenate([fmt.round(near), special])
+    arrays = [values] + ([values.astype(np.float32)] if ar.native and ar.precision != "fp64" else [])
+    for arr in arrays:
+        hexes, decs = encode(ar, arr, stage)
+        want = [_encode_one(ar, v, stage) for v in arr]
+        assert list(zip(hexes, decs)) == want
+        assert decs[-11:-7] == ["nan", "nan", "inf", "-inf"] and int(hexes[-6], 16) == 1 << (fmt.bits - 1)  # -0

@@ -360,12 +360,8 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
     subtrees lying behind its origins."""
     n = len(fr.sf)
     centers = fr.bnd[:, :3]
-    along = np.zeros((0, 4), fr.dtype)
-    none = np.full(n, np.inf)
-    everywhere = {"axes": np.eye(3)[:2]} if lp.parallel else {"apex": np.zeros(3)}  # bounds of infinite radii
-    unbounded = _ShadowBounds(none, fr.tree.refit(fr.bnd, none, **everywhere), along)  # every ray tests every shape
     if not hits[native.OUT_HITS]:
-        return unbounded
+        return _unbounded(fr, lp)
     lo, hi = hits[native.OUT_LO:native.OUT_LO + 3], hits[native.OUT_HI:native.OUT_HI + 3]
     magnitude = max(np.abs(lo).max(), np.abs(hi).max())  # of any hit point's coordinates
     u, tiny = fr.ar.unit_roundoff, fr.ar.tiny
@@ -377,14 +373,14 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
         apex = light[native.LT_LOC:native.LT_LOC + 3].astype(np.float64)
         origins = _report_origins(_run(fr.jobs, n_pix, fr.kernel("shadow_origins"), lp, _ORIGINS))
         if not origins[8]:
-            return unbounded
+            return _unbounded(fr, lp)
         bounded = fr.bounded & bool(np.isfinite(apex).all())
         radius = bounds.cull_radii(fr.bnd, bounded, far, float(origins[9]), u, tiny, fr.fp16, fr.jobs)
         radius += far * (origins[7] * (1 + bounds.SLACK) + 1e-15) + slack
-        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex), along)
+        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex), np.zeros((0, 4), fr.dtype))
     length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
-        return unbounded
+        return _unbounded(fr, lp)
     radius = bounds.cull_radii(fr.bnd, fr.bounded, far, length, u, tiny, fr.fp16, fr.jobs) + slack
     along = np.empty((n, 4), fr.dtype)
     fr.kernel("shadow_directions")(byref(fr.shapes), light.ctypes.data, along.ctypes.data)
@@ -395,6 +391,13 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
     node_keys = np.empty((fr.tree.nodes, 3))
     lib.bvh_keys(flat.struct(), keys.ctypes.data, node_keys.ctypes.data)
     return _ShadowBounds(radius, flat, along, behind, node_keys)
+
+
+def _unbounded(fr: _Frame, lp: native.LightPass) -> _ShadowBounds:
+    """Bounds of infinite radii: every shadow ray tests every shape."""
+    none = np.full(len(fr.sf), np.inf)
+    everywhere = {"axes": np.eye(3)[:2]} if lp.parallel else {"apex": np.zeros(3)}
+    return _ShadowBounds(none, fr.tree.refit(fr.bnd, none, **everywhere), np.zeros((0, 4), fr.dtype))
 
 
 def _unit(v: np.ndarray) -> tuple[float, np.ndarray]:

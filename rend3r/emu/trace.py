@@ -12,8 +12,8 @@ from __future__ import annotations
 import json
 import math
 import re
-from dataclasses import replace
-from typing import Callable, Iterable, Sequence
+from dataclasses import dataclass, replace
+from typing import Callable, Iterable, Iterator, Sequence
 
 import numpy as np
 
@@ -31,10 +31,15 @@ def encode(ar: Arith, values, stage: str | None = None) -> tuple[list[str], list
     arr = np.asarray(values).reshape(-1)
     bits, digits = ar.bits_array(arr, stage)
     hexes = [f"0x{b:0{digits}x}" for b in bits.tolist()]
-    decs: list[float | str] = arr.astype(np.float64).tolist()
-    for i in np.flatnonzero(~np.isfinite(arr)).tolist():
+    return hexes, decimals(arr)
+
+
+def decimals(values: np.ndarray) -> list[float | str]:
+    """The records' ``dec`` of working-precision values: floats, non-finite ones as text."""
+    decs: list[float | str] = values.astype(np.float64).tolist()
+    for i in np.flatnonzero(~np.isfinite(values)).tolist():
         decs[i] = "nan" if math.isnan(decs[i]) else ("inf" if decs[i] > 0 else "-inf")
-    return hexes, decs
+    return decs
 
 
 def _int_records(values) -> tuple[list[str], list[int]]:
@@ -43,15 +48,16 @@ def _int_records(values) -> tuple[list[str], list[int]]:
     return [f"-0x{-v:x}" if v < 0 else f"0x{v:x}" for v in ints], ints
 
 
+def _column(ar: Arith, stage: str, values, integer: bool = False) -> tuple[list[str], list]:
+    """(hexes, decimals) of one stage's values (e.g. one per shape)."""
+    return _int_records(values) if integer else encode(ar, values, _value_stage(ar, stage))
+
+
 class _Writer:
     """Turns (stage, values) into records for one pixel."""
 
     def __init__(self, ar: Arith, emit: Emit, frame: int, pixel: tuple[int, int]) -> None:
         self.ar, self.emit, self.frame, self.pixel = ar, emit, frame, pixel
-
-    def column(self, stage: str, values, integer: bool = False) -> tuple[list[str], list]:
-        """(hexes, decimals) of one stage's values (e.g. one per shape)."""
-        return _int_records(values) if integer else encode(self.ar, values, _value_stage(self.ar, stage))
 
     def rows(self, stages: Sequence[str], columns: Sequence[tuple[list[str], list]], shapes: Sequence[int | None]) -> None:
         """For each shape in order, a record of each stage: ``columns[k]`` holds stage k's
@@ -67,7 +73,7 @@ class _Writer:
 
     def put(self, stage: str, value, shape: int | None, integer: bool = False) -> None:
         """The record of one value."""
-        (hx,), (dec,) = self.column(stage, [value], integer)
+        (hx,), (dec,) = _column(self.ar, stage, [value], integer)
         self.record(stage, shape, hx, dec)
 
 
@@ -88,23 +94,60 @@ def parse_pixel(text: str) -> tuple[int, int]:
     return int(m[1]), int(m[2])
 
 
-_SHAPE_STAGES = ("origin.x", "origin.y", "origin.z", "dir.x", "dir.y", "dir.z", "a2", "b", "c2", "disc", "sqrt",
-                 "t1", "t2", "t", "hit", "sq_dist", "point.x", "point.y", "point.z", "normal.x", "normal.y", "normal.z")
+#: The stages a raytraced pixel records for each shape, in order.
+SHAPE_STAGES = ("origin.x", "origin.y", "origin.z", "dir.x", "dir.y", "dir.z", "a2", "b", "c2", "disc", "sqrt",
+                "t1", "t2", "t", "hit", "sq_dist", "point.x", "point.y", "point.z", "normal.x", "normal.y", "normal.z")
 _LIGHT_STAGES = ("l.x", "l.y", "l.z", "n_dot_l", "n_len", "l_len", "denom", "cos", "f")
 _FIXED, _LIT, _SHADOW = 9, 10, 11
 
 
+@dataclass(frozen=True)
+class Trace:
+    """One pixel's records (``docs/trace.md``): first a table of :data:`SHAPE_STAGES`, one
+    row per shape (raytracing; values kept as arrays, made records when asked), then the
+    other records."""
+
+    ar: Arith
+    frame: int
+    pixel: tuple[int, int]
+    shapes: np.ndarray  # (rows,) the table's shape indices
+    values: np.ndarray  # (rows, len(SHAPE_STAGES)) working-precision values
+    rest: list[dict]
+
+    def columns(self, rows: np.ndarray | None = None) -> list[tuple[list[str], list]]:
+        """Each stage's (hexes, decimals) over the table's ``rows`` (all: None)."""
+        values = self.values if rows is None else self.values[rows]
+        return [_column(self.ar, stage, values[:, k], integer=stage == "hit") for k, stage in enumerate(SHAPE_STAGES)]
+
+    def table_records(self, rows: np.ndarray | None = None) -> list[dict]:
+        """The records of the table's ``rows`` (all: None), row by row."""
+        out: list[dict] = []
+        shapes = self.shapes if rows is None else self.shapes[rows]
+        _Writer(self.ar, out.append, self.frame, self.pixel).rows(SHAPE_STAGES, self.columns(rows), shapes.tolist())
+        return out
+
+    def records(self) -> list[dict]:
+        """Every record, in order."""
+        return self.table_records() + self.rest
+
+
 def trace_raytrace(scene: Scene, options: EmuOptions, frame: int, pixels: Iterable[tuple[int, int]], emit: Emit) -> None:
     """Emit the records of each pixel of one raytraced frame (``docs/trace.md`` order)."""
+    for t in raytrace_traces(scene, options, frame, pixels):
+        for record in t.records():
+            emit(record)
+
+
+def raytrace_traces(scene: Scene, options: EmuOptions, frame: int, pixels: Iterable[tuple[int, int]]) -> Iterator[Trace]:
+    """The trace of each pixel of one raytraced frame."""
     from .raytracer import set_up, trace_pixel
 
     ar = options.arith
     fr = set_up(scene, options)
     for x, y in pixels:
-        w = _Writer(ar, emit, frame, (x, y))
+        rest: list[dict] = []
+        w = _Writer(ar, rest.append, frame, (x, y))
         t = trace_pixel(fr, options, x, y)
-        columns = [w.column(stage, t.shapes[:, k], integer=stage == "hit") for k, stage in enumerate(_SHAPE_STAGES)]
-        w.rows(_SHAPE_STAGES, columns, fr.index[: len(t.shapes)].tolist())
         winner = int(fr.index[t.nearest]) if t.nearest >= 0 else None
         # A winner whose hit point or lighting is not finite is a miss in the frame
         # (background, provenance -1): nearest says so too; its light stages show why.
@@ -120,10 +163,18 @@ def trace_raytrace(scene: Scene, options: EmuOptions, frame: int, pixels: Iterab
                 if values[_LIT]:
                     w.put(tag + "shadow", int(values[_SHADOW]), winner, integer=True)
         w.put("colour", options.background if t.colour is None else t.colour, shown, integer=True)
+        yield Trace(ar, frame, (x, y), fr.index[: len(t.shapes)].copy(), t.shapes, rest)
 
 
 def trace_raster(scene: Scene, options: EmuOptions, frame: int, pixels: Iterable[tuple[int, int]], emit: Emit) -> None:
-    """Emit the records of each pixel of one rasterized frame (``docs/trace.md``).
+    """Emit the records of each pixel of one rasterized frame (``docs/trace.md``)."""
+    for t in raster_traces(scene, options, frame, pixels):
+        for record in t.records():
+            emit(record)
+
+
+def raster_traces(scene: Scene, options: EmuOptions, frame: int, pixels: Iterable[tuple[int, int]]) -> Iterator[Trace]:
+    """The trace of each pixel of one rasterized frame (no table: every record is a rest).
 
     Per triangle (index order): its camera-space vertices, their projection steps (for a
     triangle the near plane or guard band clips, the unclipped vertices' projection, with
@@ -141,7 +192,8 @@ def trace_raster(scene: Scene, options: EmuOptions, frame: int, pixels: Iterable
     view = frame_view(scene, options)
     result, _ = render_frame(scene, options, frame)
     for x, y in pixels:
-        w = _Writer(ar, emit, frame, (x, y))
+        rest: list[dict] = []
+        w = _Writer(ar, rest.append, frame, (x, y))
         for k in range(len(index)):
             idx = int(index[k])
             one = tris[k : k + 1]
@@ -162,12 +214,13 @@ def trace_raster(scene: Scene, options: EmuOptions, frame: int, pixels: Iterable
         w.put("nearest", shown, tri, integer=True)
         w.put("depth", ar.round(result.depth[y, x]), tri)
         w.put("colour", int(result.rgb565[y, x]), tri, integer=True)
+        yield Trace(ar, frame, (x, y), np.zeros(0, np.int64), np.zeros((0, len(SHAPE_STAGES))), rest)
 
 
 def _put_all(w: _Writer, stage: str, values, shape: int | None) -> None:
     """Record a lighting stage (0-d, or one value per traced point; empty: not reached)."""
     arr = np.asarray(values).reshape(-1)
-    for hx, dec in zip(*w.column(stage, arr, integer=arr.dtype.kind in "biu")):
+    for hx, dec in zip(*_column(w.ar, stage, arr, integer=arr.dtype.kind in "biu")):
         w.record(stage, shape, hx, dec)
 
 

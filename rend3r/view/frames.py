@@ -1,6 +1,6 @@
 """A REND3R program's frames, their difference from fp64, and pixel histories, all from
-the emulator's own functions (:func:`run_program`, :func:`trace_raytrace`,
-:func:`trace_raster`): the view shows what ``rend3r emulate`` computes."""
+the emulator's own functions (:func:`run_program`, :func:`raytrace_traces`,
+:func:`raster_traces`): the view shows what ``rend3r emulate`` computes."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..emu.trace import SHAPE_STAGES, Trace, decimals
 from .params import RequestError
 
 #: Bytes of rendered frames kept for reuse (older option sets are dropped first).
@@ -98,9 +99,9 @@ class TraceCache:
 
     def __init__(self, size: int = 8) -> None:
         self.size = size
-        self._traces: OrderedDict[tuple, list[dict]] = OrderedDict()
+        self._traces: OrderedDict[tuple, Trace] = OrderedDict()
 
-    def trace(self, version: int, words: Sequence[int], options, frame: int, x: int, y: int) -> list[dict]:
+    def trace(self, version: int, words: Sequence[int], options, frame: int, x: int, y: int) -> Trace:
         key = (version, options, frame, x, y)
         if key not in self._traces:
             self._traces[key] = trace(words, options, frame, x, y)
@@ -110,23 +111,25 @@ class TraceCache:
         return self._traces[key]
 
 
-def trace(words: Sequence[int], options, frame: int, x: int, y: int) -> list[dict]:
-    """The records ``rend3r emulate --trace-pixel X,Y`` prints for frame ``frame``."""
+def trace(words: Sequence[int], options, frame: int, x: int, y: int) -> Trace:
+    """The trace whose records ``rend3r emulate --trace-pixel X,Y`` prints for frame ``frame``."""
     from ..emu.processor import execute
-    from ..emu.trace import trace_raster, trace_raytrace
+    from ..emu.trace import raster_traces, raytrace_traces
 
     if options.mode == "hybrid":
         raise RequestError("hybrid frames have no pixel trace (docs/trace.md)", 422)
-    tracer = trace_raster if options.mode == "raster" else trace_raytrace
-    out: list[dict] = []
+    tracer = raster_traces if options.mode == "raster" else raytrace_traces
+    out: list[Trace] = []
 
     def on_nf(scene, number: int) -> None:
         if number == frame:
-            tracer(scene, options, number, [(x, y)], out.append)
+            out.extend(tracer(scene, options, number, [(x, y)]))
 
     with quiet_numpy():
         execute(words, options, frame + 1, on_nf)
-    return out
+    if not out:
+        raise RequestError(f"the program renders no frame {frame}", 422)
+    return out[0]
 
 
 def _occurrences(records: list[dict]) -> Iterator[tuple]:
@@ -162,6 +165,30 @@ def _agreement(ar, work: list[dict], ref: list[dict]) -> tuple[list[dict | None]
     return pairs, paired & np.where(integer, mine == theirs, same_value), integer
 
 
+_INTEGER = np.array([stage == "hit" for stage in SHAPE_STAGES])
+_HIT, _SQ_DIST = SHAPE_STAGES.index("hit"), SHAPE_STAGES.index("sq_dist")
+
+
+def _table_agreement(ar, work: Trace, ref: Trace) -> tuple[np.ndarray, np.ndarray]:
+    """For each row of the working trace's table, the fp64 table's row of the same shape
+    (-1: none), and whether each of its values agrees with that row's (as :func:`_agreement`
+    judges)."""
+    if np.array_equal(work.shapes, ref.shapes):
+        pos = np.arange(len(work.shapes))
+    elif len(ref.shapes):
+        order = np.argsort(ref.shapes, kind="stable")
+        at = order[np.searchsorted(ref.shapes, work.shapes, sorter=order).clip(0, len(order) - 1)]
+        pos = np.where(ref.shapes[at] == work.shapes, at, -1)
+    else:
+        pos = np.full(len(work.shapes), -1)
+    mine = work.values
+    theirs = np.where((pos >= 0)[:, None], ref.values[pos.clip(0)] if len(ref.values) else np.nan, np.nan)
+    with quiet_numpy():
+        rounded = np.asarray(ar.round(theirs), dtype=np.float64)
+    same_value = (mine == rounded) | (np.isnan(mine) & np.isnan(rounded))
+    return pos, (pos >= 0)[:, None] & np.where(_INTEGER, mine == theirs, same_value)
+
+
 #: How the shape shown is chosen: raytracing, then each raster visibility rule
 #: (docs/emulator.md, docs/raster.md).
 TIE_RULES = {"raytrace": "the smallest sq_dist wins; equal distances go to the lower shape index (docs/emulator.md)",
@@ -170,16 +197,34 @@ TIE_RULES = {"raytrace": "the smallest sq_dist wins; equal distances go to the l
              "index": "no depth order: later triangles paint over earlier ones (quirk raster-index-order)"}
 
 
-def _hits(work: list[dict], ref: list[dict]) -> list[dict]:
+def _hits(work: Trace, ref: Trace) -> list[dict]:
     """The shapes a raytraced pixel's ray hit, nearest first (ties in index order), with
     their squared distances in both runs."""
-    def distances(records: list[dict]) -> dict[int, object]:
-        hit = {r["shape"] for r in records if r["stage"] == "hit" and r["dec"] == 1}
-        return {r["shape"]: r["dec"] for r in records if r["stage"] == "sq_dist" and r["shape"] in hit}
+    def distances(t: Trace) -> dict[int, float | str]:
+        hit = t.values[:, _HIT] == 1
+        return dict(zip(t.shapes[hit].tolist(), decimals(t.values[hit, _SQ_DIST])))
 
     mine, theirs = distances(work), distances(ref)
     order = sorted(mine, key=lambda shape: (float(mine[shape]), shape))
     return [{"shape": shape, "sq_dist": mine[shape], "fp64_sq_dist": theirs.get(shape)} for shape in order]
+
+
+def _hit_shapes(t: Trace) -> set:
+    """The shapes a trace records as hit."""
+    return set(t.shapes[t.values[:, _HIT] == 1].tolist()) | {
+        r["shape"] for r in t.rest if r["stage"] == "hit" and r["dec"] == 1}
+
+
+def _table_rows(work: Trace, ref: Trace, rows: np.ndarray, pos: np.ndarray, agree: np.ndarray) -> list[dict]:
+    """The records of the working table's ``rows`` with the fp64 values of its rows ``pos``
+    (-1: none) beside them (as :func:`_row`), and whether they diverge (not ``agree``)."""
+    records = work.table_records(rows)  # made here, so extended in place
+    fp64 = zip(*(zip(hexes, decs) for hexes, decs in ref.columns(pos[pos >= 0])))
+    theirs = (value for p in pos.tolist() for value in (next(fp64) if p >= 0 else (None,) * len(SHAPE_STAGES)))
+    for r, f, agrees in zip(records, theirs, agree.ravel().tolist()):
+        r["fp64"] = None if f is None else {"hex": f[0], "dec": f[1]}
+        r["diverges"] = not agrees
+    return records
 
 
 def _first(flags: np.ndarray) -> int | None:
@@ -206,21 +251,32 @@ def history(words: Sequence[int], options, frame: int, x: int, y: int, all_shape
     work = traces.trace(version, words, options, frame, x, y)
     ref = traces.trace(version, words, reference(options), frame, x, y)
     ar = options.arith
-    pairs, agree, integer = _agreement(ar, work, ref)
+    pos, table_agree = _table_agreement(ar, work, ref)
+    pairs, rest_agree, rest_integer = _agreement(ar, work.rest, ref.rest)
+    width = len(SHAPE_STAGES)
+    cut = table_agree.size  # the table's records come first, row by row
+    agree = np.concatenate([table_agree.ravel(), rest_agree])
+    integer = np.concatenate([np.broadcast_to(_INTEGER, table_agree.shape).ravel(), rest_integer])
     first = _first(~agree)
     decision = _first(~agree & integer)
-    split = next((i for i, r in enumerate(work) if r["stage"] == "nearest"), len(work))
-    shapes = {r["shape"] for r in work[:split]}
+    split = cut + next((i for i, r in enumerate(work.rest) if r["stage"] == "nearest"), len(work.rest))
+    shapes = set(work.shapes.tolist()) | {r["shape"] for r in work.rest[: split - cut]}
     keep = shapes
     if len(shapes) > ALL_SHAPES_UP_TO and not all_shapes:
-        keep = {r["shape"] for r in work + ref if r["stage"] == "hit" and r["dec"] == 1}
-        keep |= {r["dec"] for r in work + ref if r["stage"] == "nearest"}
-        keep |= {work[i]["shape"] for i in (first, decision) if i is not None and i < split}
-    shown = [i for i in range(len(work)) if i >= split or work[i]["shape"] in keep]
-    index = {i: n for n, i in enumerate(shown)}
-    records = [_row(work[i], pairs[i], bool(agree[i])) for i in shown]
+        keep = _hit_shapes(work) | _hit_shapes(ref)
+        keep |= {r["dec"] for r in work.rest + ref.rest if r["stage"] == "nearest"}
+        keep |= {int(work.shapes[i // width]) if i < cut else work.rest[i - cut]["shape"]
+                 for i in (first, decision) if i is not None and i < split}
+    rows = np.flatnonzero(np.isin(work.shapes, list(keep)))
+    records = _table_rows(work, ref, rows, pos[rows], table_agree[rows])
+    rest = [j for j, r in enumerate(work.rest) if cut + j >= split or r["shape"] in keep]
+    records += [_row(work.rest[j], pairs[j], bool(rest_agree[j])) for j in rest]
+    shown = np.concatenate([(rows[:, None] * width + np.arange(width)).ravel(), cut + np.array(rest, dtype=np.int64)])
+
+    def place(i: int | None) -> int | None:
+        return None if i is None else int(np.searchsorted(shown, i))
+
     return {"frame": frame, "pixel": [x, y], "precision": options.precision, "label": ar.label,
             "mode": options.mode, "shapes": len(shapes), "shapes_shown": len(keep & shapes), "records": records,
-            "first_divergence": None if first is None else index[first],
-            "first_decision": None if decision is None else index[decision],
+            "first_divergence": place(first), "first_decision": place(decision),
             "hits": _hits(work, ref) if options.mode == "raytrace" else None, "tie_rule": TIE_RULES["raytrace" if options.mode == "raytrace" else options.depth]}

@@ -1,6 +1,7 @@
 """``rend3r view`` speed, over HTTP against a real server (``docs/view.md``).
 
-Run: ``python benchmarks/bench_view.py [--runs R]``. Prints the median of R runs of
+Run: ``python benchmarks/bench_view.py [--runs R] [--only history|reload]``. Prints the
+median of R runs of
 
 - a pixel's history (``GET /api/pixel``: the working-precision trace, the fp64 trace and
   their comparison, as JSON) on a front sphere of a 4,096-sphere wall (``walls.wall(4096)``,
@@ -127,10 +128,13 @@ def bench_reload(runs: int, tmp: Path) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--only", choices=("history", "reload"), help="one of the two rows")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        bench_history(args.runs, Path(tmp))
-        bench_reload(args.runs, Path(tmp))
+        if args.only != "reload":
+            bench_history(args.runs, Path(tmp))
+        if args.only != "history":
+            bench_reload(args.runs, Path(tmp))
 
 
 if __name__ == "__main__":

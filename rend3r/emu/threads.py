@@ -1,7 +1,7 @@
 """The kernels' threads: one pool per thread count, and work split into ranges.
 
 Kernels release the GIL (they are called through ctypes), so ranges of pixels, packets
-or grid cells run in parallel on ``--jobs`` threads. Every range is computed the same way
+or shapes run in parallel on ``--jobs`` threads. Every range is computed the same way
 whatever the split, so results never depend on the thread count.
 """
 
@@ -11,8 +11,6 @@ import os
 from concurrent.futures import Future, ThreadPoolExecutor
 from functools import lru_cache
 from typing import Callable
-
-import numpy as np
 
 
 def available_cores() -> int:
@@ -34,16 +32,6 @@ def ranges(n: int, jobs: int, smallest: int) -> list[tuple[int, int]]:
     parts = 1 if jobs <= 1 else max(1, min(4 * jobs, n // smallest))
     edges = [n * k // parts for k in range(parts + 1)]
     return [(a, b) for a, b in zip(edges, edges[1:]) if b > a]
-
-
-def balanced(cum: np.ndarray, jobs: int, smallest: int) -> list[tuple[int, int]]:
-    """Ranges of items 0..m whose work ``cum`` (m + 1 running totals from 0) is about
-    even: a few per thread, none under ``smallest`` work unless there is only one."""
-    m, total = len(cum) - 1, int(cum[-1])
-    parts = 1 if jobs <= 1 else max(1, min(4 * jobs, total // max(1, smallest)))
-    cuts = np.searchsorted(cum, [total * k // parts for k in range(1, parts)]).tolist()
-    edges = sorted({0, m, *(min(max(c, 0), m) for c in cuts)})
-    return [(a, b) for a, b in zip(edges, edges[1:])]
 
 
 def submit(jobs: int, fn: Callable[..., object], *args: object) -> Future:

@@ -2,7 +2,7 @@
  *
  * Arrays are C-contiguous; "working" arrays hold float (fp16, fp32) or double (fp64)
  * values, the same type throughout one call. Every index a kernel follows (shape slots in
- * grid lists, pixel ranges) was produced or checked by the Python side before the call.
+ * tree leaves, pixel ranges) was produced or checked by the Python side before the call.
  */
 #ifndef REND3R_KERNELS_H
 #define REND3R_KERNELS_H

@@ -12,6 +12,18 @@ import click
 #: Largest width or height any command renders or reads (bounds memory: 8192x8192 RGB565).
 MAX_SIDE = 8192
 
+def finite(lo: float, hi: float):
+    """A click callback refusing NaN, infinities and values outside [lo, hi] (click's
+    FloatRange lets NaN through: every comparison with it is false)."""
+
+    def check(ctx, param, value: float | None) -> float | None:
+        if value is not None and not lo <= value <= hi:  # also False for NaN
+            raise click.BadParameter(f"{value} is not in the range {lo:g}..{hi:g}")
+        return value
+
+    return check
+
+
 _SIZE = re.compile(r"\s*([0-9]+)\s*[xX]\s*([0-9]+)\s*", re.ASCII)
 
 

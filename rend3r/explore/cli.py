@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import click
 
 from ..campaign.options import SCHEDULER
-from ..cliutil import JOBS, MAX_MEMORY, SIZE, default_memory
+from ..cliutil import JOBS, MAX_MEMORY, SIZE, default_memory, finite
 from ..errors import Rend3rError
 from ..progress import Progress, quiet_option
 
@@ -71,7 +71,7 @@ def load_spec(path: Path):
 @click.option("--subnormals", type=click.Choice(["ftz", "ieee"]), default="ftz", show_default=True,
               help="Subnormal handling of every format (fp32 and fp64 keep theirs).")
 @click.option("--size", type=SIZE, default="256x192", show_default=True, help="Image size (1..8192 each).")
-@click.option("--min-psnr", type=click.FloatRange(0), default=40.0, show_default=True, metavar="DB",
+@click.option("--min-psnr", type=float, callback=finite(0, 1000), default=40.0, show_default=True, metavar="DB",
               help="PSNR against fp64 a format must reach to serve a program.")
 @JOBS
 @SCHEDULER

@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ..cliutil import SIZE
+from ..cliutil import SIZE, finite
 from ..errors import Rend3rError
 from .metrics import ImageMetrics, as_rgb888, diff_image, image_metrics
 
@@ -84,7 +84,7 @@ def _psnr(ctx: click.Context, param: click.Parameter, value: float | None) -> fl
               help="Write a diff PNG (changed pixels magenta); missing folders are made.")
 @click.option("--diff", "old_diff_path", type=click.Path(path_type=Path), hidden=True)  # -o's older spelling
 @click.option("--max-channel", type=click.IntRange(0, 255), default=0, show_default=True, metavar="N", help="Largest allowed channel difference (RGB888).")
-@click.option("--max-share", type=click.FloatRange(0.0, 1.0), default=None, metavar="SHARE", help="Largest allowed share of differing pixels (0..1).")
+@click.option("--max-share", type=float, callback=finite(0.0, 1.0), default=None, metavar="SHARE", help="Largest allowed share of differing pixels (0..1).")
 @click.option("--min-psnr", type=float, default=None, callback=_psnr, metavar="DB", help="Smallest allowed PSNR in dB (inf: identical).")
 @click.option("--size", type=SIZE, default=None, help="Size of raw RGB565 inputs (default 512x384).")
 def compare_command(

@@ -15,7 +15,7 @@ from pathlib import Path
 import click
 
 from ..campaign.options import SCHEDULER
-from ..cliutil import SIZE
+from ..cliutil import SIZE, finite
 from ..errors import Rend3rError
 from ..fileio import Outputs
 from ..progress import Progress, quiet_option
@@ -61,17 +61,6 @@ def _memory(ctx, param, value: str | None) -> int | None:
         return parse_bytes(value)
     except ValueError as exc:
         raise click.BadParameter(str(exc)) from None
-
-
-def _finite(lo: float, hi: float):
-    """A click callback refusing NaN, infinities and values outside [lo, hi]."""
-
-    def check(ctx, param, value: float) -> float:
-        if not lo <= value <= hi:  # also False for NaN
-            raise click.BadParameter(f"{value} is not in the range {lo:g}..{hi:g}")
-        return value
-
-    return check
 
 
 @svo_group.command("model", short_help="Write a procedural mesh: sphere, torus or folded.")
@@ -232,11 +221,11 @@ def _place(ctx, param, value: str | None):
               help="Short-stack depth (0 = restart only).")
 @click.option("--float", "use_float", is_flag=True, help="float64 reference instead of 16.16.")
 @_KERNEL
-@click.option("--azimuth", type=float, default=35.0, show_default=True, callback=_finite(-1e6, 1e6),
+@click.option("--azimuth", type=float, default=35.0, show_default=True, callback=finite(-1e6, 1e6),
               metavar="DEG", help="Degrees around the vertical axis (-1e6..1e6).")
-@click.option("--elevation", type=float, default=25.0, show_default=True, callback=_finite(-89.9, 89.9),
+@click.option("--elevation", type=float, default=25.0, show_default=True, callback=finite(-89.9, 89.9),
               metavar="DEG", help="Degrees above the horizon (-89.9..89.9).")
-@click.option("--distance", type=float, default=1.6, show_default=True, callback=_finite(0.1, 1e6),
+@click.option("--distance", type=float, default=1.6, show_default=True, callback=finite(0.1, 1e6),
               metavar="D", help="Camera distance in half-diagonals of the model's cube (0.1..1e6).")
 @click.option("--cost", "cost_path", default=None, metavar="FILE",
               help="Also write the per-ray cost image (PNG).")

@@ -14,7 +14,7 @@ from pathlib import Path
 import click
 
 from ..cli import INTERRUPTED
-from ..cliutil import DEVICE_SIZE, SizeType
+from ..cliutil import DEVICE_SIZE, SizeType, finite
 from ..errors import Rend3rError
 from .execute import MAX_DEVICE_SIDE
 from .links import (
@@ -258,7 +258,7 @@ def serve(link: Link, core, stop: threading.Event, poll: float = 0.1) -> None:
 @click.option("--baud", type=int, default=115200, show_default=True, metavar="RATE")
 @click.option("--max-words", type=click.IntRange(1, 1 << 24), default=1 << 16, show_default=True, metavar="N",
               help="Largest program accepted.")
-@click.option("--max-frame-rate", type=click.FloatRange(min=0, min_open=True), default=30.0,
+@click.option("--max-frame-rate", type=float, callback=finite(1e-3, 1e6), default=30.0,
               show_default=True, metavar="FPS", help="Most frames rendered per second.")
 @click.option("--frames", "max_frames", type=click.IntRange(1), default=8, show_default=True, metavar="N",
               help="Frames rendered per program run (bounds looping programs).")

@@ -120,9 +120,10 @@ class Arith:
         return max(f.min_normal for f in (self.format, *self.stage_formats.values()))
 
     @property
-    def exp_bits(self) -> int:
-        """The fewest exponent bits of the working format or any stage's."""
-        return min(f.exp_bits for f in (self.format, *self.stage_formats.values()))
+    def overflow(self) -> float:
+        """The overflow threshold (per stage: the largest of the formats'), which the
+        culling bounds take as a limit of any finite product."""
+        return max(f.overflow for f in (self.format, *self.stage_formats.values()))
 
     @property
     def label(self) -> str:

@@ -20,15 +20,16 @@ SHAPE_CHUNK = 1 << 10
 
 
 def cull_radii(table: np.ndarray, ok: np.ndarray, dist: np.ndarray, dmin: float, u: float, tiny: float,
-               fp16: bool, jobs: int = 1) -> np.ndarray:
+               overflow: float, jobs: int = 1) -> np.ndarray:
     """Per shape, the world radius beyond which no ray line can hit (inf: no bound): rays
     whose origins lie within ``dist`` (per shape) of the centre, directions at least
-    ``dmin`` long, unit roundoff ``u`` and smallest normal ``tiny`` of the precision."""
+    ``dmin`` long, unit roundoff ``u``, smallest normal ``tiny`` and overflow threshold
+    ``overflow`` of the precision."""
     out = np.empty(len(table))
     table, flags, dist = _inputs(table, ok, dist)
     lib = native.library()
     threads.split(jobs, threads.ranges(len(out), jobs, SHAPE_CHUNK), lambda a, b: lib.bound_radii(
-        table[a:].ctypes.data, flags[a:].ctypes.data, dist[a:].ctypes.data, b - a, dmin, u, tiny, int(fp16),
+        table[a:].ctypes.data, flags[a:].ctypes.data, dist[a:].ctypes.data, b - a, dmin, u, tiny, overflow,
         out[a:].ctypes.data))
     return out
 

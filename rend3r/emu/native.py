@@ -110,10 +110,11 @@ def ptr(a: np.ndarray, dtype: type | np.dtype, shape: tuple[int | None, ...]) ->
     return a.ctypes.data
 
 
-#: Kernel suffix per (precision, flush subnormals); every other format's kernels are FORMAT's.
+#: Kernel suffix per (precision, flush subnormals); narrow formats' kernels are NARROW's (float
+#: lanes, csrc/fnarrow.h), every other format's FORMAT's (double lanes, csrc/fformat.h).
 SUFFIXES = {("fp16", True): "h16", ("fp16", False): "h16i", ("fp32", True): "f32", ("fp32", False): "f32",
             ("fp64", True): "f64", ("fp64", False): "f64"}
-FORMAT = "fmt"
+NARROW, FORMAT = "nar", "fmt"
 _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and instruction set
     "directions": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "nearest": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
@@ -133,7 +134,7 @@ _PLAIN = {
     "bvh_keys": (None, [POINTER(Bvh), c_void_p, c_void_p]),
     "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p]),
     "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_void_p, c_void_p, c_int32, c_void_p, c_void_p]),
-    "bound_radii": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_int32, c_void_p]),
+    "bound_radii": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double, c_void_p]),
     "bound_floors": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double,
                             c_void_p]),
     "have_avx2": (c_int32, []),
@@ -152,9 +153,11 @@ def library() -> ctypes.CDLL:
     lib = ctypes.CDLL(spec.origin)
     table = dict(_PLAIN)
     for name, sig in _SUFFIXED.items():
-        for suffix in {*SUFFIXES.values(), FORMAT}:
+        for suffix in {*SUFFIXES.values(), NARROW, FORMAT}:
             for isa in ("base", "avx2"):
                 table[f"{name}_{suffix}_{isa}"] = sig
+    for isa in ("base", "avx2"):
+        table[f"round_array_{NARROW}_{isa}"] = (None, [c_void_p, c_void_p, c_int64, POINTER(Format)])
     for name, (restype, argtypes) in table.items():
         fn = getattr(lib, name, None)
         if fn is not None:  # the AVX2 build exists on x86-64 only
@@ -171,12 +174,47 @@ def isa() -> str:
     return "avx2" if wanted == "avx2" and hasattr(lib, "nearest_f32_avx2") and lib.have_avx2() else "base"
 
 
+def narrow_format(f: FloatFormat) -> bool:
+    """Whether the narrow kernels (float lanes, csrc/fnarrow.h) compute in ``f`` exactly:
+    at most 10 fraction bits and at most 7 exponent bits, or 8 with subnormals flushed."""
+    return f.frac_bits <= 10 and (f.exp_bits <= 7 or (f.exp_bits == 8 and f.ftz))
+
+
+def narrow(ar: Arith) -> bool:
+    """Whether ``ar`` runs on the narrow kernels: one narrow format (fp16 has kernels of its
+    own unless it judges tininess before rounding)."""
+    return not ar.native and not ar.stages and narrow_format(ar.format)
+
+
+def suffix(ar: Arith) -> str:
+    """The suffix of the kernels that compute in ``ar``'s working precision."""
+    if ar.native:
+        return SUFFIXES[ar.precision, ar.ftz]
+    return NARROW if narrow(ar) else FORMAT
+
+
+def dtype(ar: Arith) -> np.dtype:
+    """The element type of the kernels' working arrays for ``ar``: float32 for fp16, fp32
+    and narrow formats (whose values float32 holds exactly), else float64."""
+    return np.dtype(np.float32 if suffix(ar) in ("h16", "h16i", "f32", NARROW) else np.float64)
+
+
 def kernel(name: str, ar: Arith) -> ctypes._CFuncPtr:
-    """The kernel ``name`` compiled for a working precision and subnormal handling (any
-    other format, and fp16 judging tininess before rounding: the format kernels, given
-    the format)."""
-    suffix = SUFFIXES[ar.precision, ar.ftz] if ar.native else FORMAT
-    return getattr(library(), f"{name}_{suffix}_{isa()}")
+    """The kernel ``name`` compiled for a working precision and subnormal handling (the
+    narrow and format kernels are given the format)."""
+    return getattr(library(), f"{name}_{suffix(ar)}_{isa()}")
+
+
+def round_narrow(values: np.ndarray, ar: Arith, instruction_set: str | None = None) -> np.ndarray:
+    """float32 values rounded to ``ar``'s narrow format by the narrow kernels' rounding (for
+    tests; ``instruction_set``: "base" or "avx2", default the one in use)."""
+    if ar.stages or not narrow_format(ar.format):
+        raise ValueError(f"{ar.label} is not a narrow format")
+    a = np.ascontiguousarray(values, np.float32)
+    out = np.empty_like(a)
+    fn = getattr(library(), f"round_array_{NARROW}_{instruction_set or isa()}")
+    fn(a.ctypes.data, out.ctypes.data, a.size, Format.of(ar))
+    return out
 
 
 def round16(values: np.ndarray, ftz: bool) -> np.ndarray:

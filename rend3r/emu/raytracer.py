@@ -32,7 +32,7 @@ import numpy as np
 from ..isa import Table, lookup
 from ..isa.tables import PROP_LIMIT, SHAPE_TYPE_CODES
 from . import bounds, bvh, native, threads
-from .arith import PRECISIONS, Arith
+from .arith import Arith
 from .camera import camera_rays
 from .frame import Frame
 from .lights import POINT, Light, lights_from_scene
@@ -74,9 +74,6 @@ class _Frame:
     shapes: native.Shapes
     tree: bvh.Tree
 
-    @property
-    def fp16(self) -> bool:
-        return self.ar.precision == "fp16"
 
     def kernel(self, name: str):
         """The compiled kernel ``name`` for this frame's precision."""
@@ -117,7 +114,7 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
 def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     """What every band of the frame shares: camera, shape and light tables."""
     ar = options.arith
-    dtype = np.dtype(ar.dtype)
+    dtype = native.dtype(ar)
     rays = camera_rays(scene, options, ar)
     cam = np.zeros(native.CAM_COLUMNS, dtype)
     cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3] = [np.asarray(c, dtype) for c in rays.origin]
@@ -146,16 +143,15 @@ _KINDS = np.array([SHAPE_TYPE_CODES["sphere"], SHAPE_TYPE_CODES["cylinder"], SHA
 
 def _shape_tables(scene: Scene, ar: Arith, fmt) -> tuple[np.ndarray, ...]:
     """The shapes that are on, as the kernels' tables (csrc/datapath.inc shape_tables):
-    (floats, ints, bounds, bounded, program index), in index order. Shapes are bounded
-    (culled, csrc/bounds.h) in fp16, fp32, fp64 and formats with fp32's exponent range or
-    wider, whose products of scene values cannot overflow, as section 7 of
-    docs/emulator.md assumes (with per-stage formats: every stage's, the bounds taking the
-    arith's staged unit roundoff); in narrower formats every ray tests every shape."""
+    (floats, ints, bounds, bounded, program index), in index order. Spheres with moderate
+    maps are bounded (culled, csrc/bounds.h) in every format: a test that overflows is a
+    miss, and a format too coarse for the bounds (docs/emulator.md section 7) gets infinite
+    cull radii from them."""
     table = scene.objects
     values = np.ascontiguousarray(table.values, np.uint16)
     index = np.ascontiguousarray(table.index, np.int64)
     rows = len(index)
-    sf = np.zeros((rows, native.SF_COLUMNS), ar.dtype)
+    sf = np.zeros((rows, native.SF_COLUMNS), native.dtype(ar))
     si = np.empty((rows, native.SI_COLUMNS), np.int64)
     bnd = np.empty((rows, native.B_COLUMNS))
     bounded = np.empty(rows, np.uint8)
@@ -163,8 +159,6 @@ def _shape_tables(scene: Scene, ar: Arith, fmt) -> tuple[np.ndarray, ...]:
     n = native.kernel("shape_tables", ar)(
         native.ptr(values, np.uint16, (rows, PROP_LIMIT)), index.ctypes.data, rows, _SHAPE_PROPS.ctypes.data,
         _KINDS.ctypes.data, sf.ctypes.data, si.ctypes.data, bnd.ctypes.data, bounded.ctypes.data, out.ctypes.data, fmt)
-    if not ((not ar.stages and ar.precision in PRECISIONS) or ar.exp_bits >= 8):
-        bounded[:] = 0
     return sf[:n], si[:n], bnd[:n], bounded[:n].astype(bool), out[:n]
 
 
@@ -301,7 +295,7 @@ def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> tuple[bvh.Bounds, np.
     with np.errstate(all="ignore"):  # a camera at infinity: nothing is bounded
         dist = np.linalg.norm(fr.bnd[:, :3] - apex, axis=1)
     u, tiny = fr.ar.unit_roundoff, fr.ar.tiny
-    radius = bounds.cull_radii(fr.bnd, bounded, dist, dmin, u, tiny, fr.fp16, fr.jobs)
+    radius = bounds.cull_radii(fr.bnd, bounded, dist, dmin, u, tiny, fr.ar.overflow, fr.jobs)
     floor = bounds.depth_floors(fr.bnd, bounded, dist, dmin, dmax, u, tiny, fr.jobs)
     pc = np.empty((len(radius), native.PC_COLUMNS))
     native.library().bound_primary(fr.bnd.ctypes.data, radius.ctypes.data, len(radius), apex.ctypes.data, dmin, u,
@@ -375,13 +369,13 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
         if not origins[8]:
             return _unbounded(fr, lp)
         bounded = fr.bounded & bool(np.isfinite(apex).all())
-        radius = bounds.cull_radii(fr.bnd, bounded, far, float(origins[9]), u, tiny, fr.fp16, fr.jobs)
+        radius = bounds.cull_radii(fr.bnd, bounded, far, float(origins[9]), u, tiny, fr.ar.overflow, fr.jobs)
         radius += far * (origins[7] * (1 + bounds.SLACK) + 1e-15) + slack
         return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex), np.zeros((0, 4), fr.dtype))
     length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
         return _unbounded(fr, lp)
-    radius = bounds.cull_radii(fr.bnd, fr.bounded, far, length, u, tiny, fr.fp16, fr.jobs) + slack
+    radius = bounds.cull_radii(fr.bnd, fr.bounded, far, length, u, tiny, fr.ar.overflow, fr.jobs) + slack
     along = np.empty((n, 4), fr.dtype)
     fr.kernel("shadow_directions")(byref(fr.shapes), light.ctypes.data, along.ctypes.data)
     behind = _behind_terms(fr, radius, light)

@@ -94,6 +94,13 @@ class FloatFormat:
         return float(np.ldexp(2.0 - 2.0**-self.frac_bits, self.emax))
 
     @property
+    def overflow(self) -> float:
+        """The overflow threshold: the least magnitude that rounds to infinity, the largest
+        finite value plus half its ulp (inf where float64 cannot hold it)."""
+        with np.errstate(over="ignore"):
+            return float(np.ldexp(2.0 - 2.0**-(self.frac_bits + 1), self.emax))
+
+    @property
     def min_normal(self) -> float:
         return float(np.ldexp(1.0, self.emin))
 

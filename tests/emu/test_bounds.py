@@ -1,6 +1,6 @@
-"""The bounds behind the raytracer's grids are sound, and the grids change no pixel.
+"""The bounds behind the raytracer's hierarchy are sound, and culling changes no pixel.
 
-Rays are aimed at and around random ellipsoids in every precision and computed with the
+Rays are aimed at and around random ellipsoids in many formats and computed with the
 reference raycaster: every computed hit lies within the cull radius of its line and no
 nearer than the depth floor. Deep scenes (front spheres hiding columns behind them) render
 as the reference renders them, while testing a small share of the pairs.
@@ -20,7 +20,10 @@ from rend3r.emu.shapes import origin_term, shapes_from_scene, solve, squared_dis
 
 from .scenes import Prog
 
-ARITHS = [("fp16", "ftz"), ("fp16", "ieee"), ("fp32", "ftz"), ("fp64", "ftz")]
+ARITHS = [("fp16", "ftz"), ("fp16", "ieee"), ("fp32", "ftz"), ("fp64", "ftz"), ("e6m9", "ftz"), ("e6m9", "ieee")]
+#: Formats of fewer exponent bits than fp32, or coarser fractions: their products overflow
+#: (a miss) and the bounds take their own u, smallest normal and overflow threshold.
+OTHER = [("e5m7", "ftz"), ("e7m4", "ieee"), ("bf16", "ftz"), ("e4m10", "ieee"), ("e6m20", "ftz")]
 coord = st.floats(-3, 3, allow_nan=False, width=16)
 
 
@@ -40,7 +43,7 @@ def _rays(ar, center, origin, radius, rng, count=4000):
 
 
 @settings(max_examples=120)
-@given(st.sampled_from(ARITHS), st.tuples(coord, coord, st.floats(-12, -2, allow_nan=False, width=16)),
+@given(st.sampled_from(ARITHS + OTHER), st.tuples(coord, coord, st.floats(-12, -2, allow_nan=False, width=16)),
        st.floats(0.25, 4.0, width=16), st.floats(0.75, 1.25, width=16),
        st.tuples(*[st.floats(-1, 1, allow_nan=False, width=16)] * 4), st.tuples(coord, coord), st.integers(0, 2**31))
 def test_every_computed_hit_is_within_the_cull_radius_and_beyond_the_depth_floor(arith, loc, inv, stretch, q, cam,
@@ -58,7 +61,7 @@ def test_every_computed_hit_is_within_the_cull_radius_and_beyond_the_depth_floor
     d64 = np.stack([np.asarray(c, np.float64) for c in d], axis=1)
     length = np.linalg.norm(d64, axis=1)
     dist = np.array([np.linalg.norm(center - o64)])
-    radius = bounds.cull_radii(table, ok, dist, length.min(), ar.unit_roundoff, ar.tiny, ar.precision == "fp16")[0]
+    radius = bounds.cull_radii(table, ok, dist, length.min(), ar.unit_roundoff, ar.tiny, ar.overflow)[0]
     floor = bounds.depth_floors(table, ok, dist, length.min(), length.max(), ar.unit_roundoff, ar.tiny)[0]
     s = shapes.take(0)
     S, D = to_object(ar, s, origin, d)

@@ -23,24 +23,31 @@
  * this asks |D| >= 2**-4, as before; fp32 and fp64 allow any direction that is not
  * near their own underflow. */
 #define MAX_UU 0.015625
-/* A finite float16 a2*c2 is below 65520; with the coefficients' rounding error allowed
- * for, |D|^2 (|S|^2 - 1) stays below 16380 * 1.02 / (1 - 2**-6)**2. */
-#define F16_PRODUCT_LIMIT (16380.0 * 1.02 / ((1.0 - 0.015625) * (1.0 - 0.015625)))
+/* A finite a2*c2 is below the format's overflow threshold T (65520 for float16); with the
+ * coefficients' rounding error allowed for, |D|^2 (|S|^2 - 1) stays below
+ * T/4 * 1.02 / (1 - 2**-6)**2 for float16's u = 2**-11: that slack of 5.3% is about a
+ * hundred roundings of 2**-11, and a coarser format takes it to the power u / 2**-11
+ * (as many roundings of its own u). T infinite: no limit. */
+static inline double product_limit(double overflow, double u)
+{
+    double limit = overflow / 4.0 * 1.02 / ((1.0 - 0.015625) * (1.0 - 0.015625));
+    if (u > 0x1p-11)
+        limit *= pow(1.02 / ((1.0 - 0.015625) * (1.0 - 0.015625)), u * 0x1p11 - 1.0);
+    return limit;
+}
 
 /* dist bounds the distance from the rays' origins to the centre, dmin the rays' direction
- * lengths from below; INFINITY: no bound. */
+ * lengths from below, limit is product_limit(); INFINITY: no bound. */
 static inline double cull_radius(double smin, double smax, double dist, double dmin, double u, double tiny,
-                                 int fp16)
+                                 double limit)
 {
     double dhat = smin * dmin;  /* |D| in normal space, at least */
     double uu = u + tiny / fmin(1.0, dhat * dhat);
     if (!(uu <= MAX_UU))
         return INFINITY;
     double mm = smax * dist;
-    if (fp16) {
-        double cap = sqrt(1.0 + F16_PRODUCT_LIMIT / (dhat * dhat));
-        mm = mm < cap ? mm : cap;
-    }
+    double cap = sqrt(1.0 + limit / (dhat * dhat));  /* a larger |S| overflows a2*c2 */
+    mm = mm < cap ? mm : cap;
     double h = sqrt(1.0 + 24.0 * uu * (1.0 + mm * mm)) + 16.0 * uu * mm * (1.0 + smax / smin);
     double r = h / smin * (1.0 + BOUND_SLACK) + BOUND_SLACK;
     return isfinite(r) ? r : INFINITY;

@@ -257,11 +257,12 @@ void bvh_keys(const Bvh *t, const double *keys, double *out)
 /* ---- bounds per shape (rend3r/emu/bounds.py) ---- */
 
 void bound_radii(const double *bnd, const uint8_t *ok, const double *dist, int64_t n, double dmin, double u,
-                 double tiny, int32_t fp16, double *out)
+                 double tiny, double overflow, double *out)
 {
+    double limit = product_limit(overflow, u);
     for (int64_t s = 0; s < n; s++) {
         const double *b = bnd + B_COLUMNS * s;
-        out[s] = ok[s] ? cull_radius(b[B_SMIN], b[B_SMAX], dist[s], dmin, u, tiny, fp16) : INFINITY;
+        out[s] = ok[s] ? cull_radius(b[B_SMIN], b[B_SMAX], dist[s], dmin, u, tiny, limit) : INFINITY;
     }
 }
 

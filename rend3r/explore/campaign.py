@@ -1,9 +1,10 @@
 """The tasks of an exploration campaign, each a pure function of plain values.
 
-A task renders one program in one format (:func:`render_design`), another scores a
-rendering against the fp64 one (:func:`score_design`), and :func:`design_cost` costs a
-format. Inputs are program words and options, outputs plain dataclasses of numbers, so a
-distributed runner can ship them to workers as they are.
+A task renders one program in one format (:func:`render_design`, the fp64 references), or
+renders it in a batch of designs and scores each against the reference
+(:func:`score_designs`; :func:`batches` cuts the work into such tasks); :func:`design_cost`
+costs a format. Inputs are program words and options, outputs plain dataclasses of
+numbers, so a distributed runner can ship them to workers as they are.
 """
 
 from __future__ import annotations
@@ -18,6 +19,14 @@ from ..precision.datapath import Resources
 #: The reference every design is scored against.
 REFERENCE = "fp64"
 
+#: Designs of one program rendered by one task, at most: a render takes milliseconds at
+#: small sizes, where Dask's one to two milliseconds a task (and the GIL its bookkeeping
+#: takes from the tasks on a local cluster) would cost several percent, and Dask's guidance
+#: is tasks well above that. A task holds fewer designs of a larger program (words x frames
+#: x pixels, the best guess of a render's work before rendering, over BATCH_WORK), and one
+#: alone when a render may take seconds, so that Ctrl-C, which waits for the tasks
+#: running, waits for one render at most.
+BATCH, BATCH_WORK = 4, 1 << 26
 
 @dataclass(frozen=True)
 class ProgramSpec:
@@ -82,9 +91,29 @@ def score_design(reference: Rendering, design: Rendering) -> Score:
 
 def render_and_score(program: ProgramSpec, precision: str, reference: Rendering, subnormals: str, width: int,
                      height: int, jobs: int = 0) -> Score:
-    """One campaign task: render ``program`` in ``precision`` and score it against ``reference``
-    (its fp64 rendering), so only the score travels back from a worker."""
+    """Render ``program`` in ``precision`` and score it against ``reference`` (its fp64
+    rendering), so only the score travels back from a worker."""
     return score_design(reference, render_design(program, precision, subnormals, width, height, jobs))
+
+
+def score_designs(program: ProgramSpec, designs: tuple[str, ...], reference: Rendering, subnormals: str,
+                  width: int, height: int, jobs: int = 0) -> list[Score]:
+    """One campaign task: :func:`render_and_score` for each of ``designs``, in order."""
+    return [render_and_score(program, d, reference, subnormals, width, height, jobs) for d in designs]
+
+
+def batches(pairs: list[tuple[ProgramSpec, str]], pixels: int) -> list[tuple[ProgramSpec, tuple[str, ...]]]:
+    """The (program, design) pairs as tasks of designs of one program (:data:`BATCH`), the
+    largest programs first, so that their long renders start early rather than finish last."""
+    per_program: dict[str, tuple[ProgramSpec, list[str]]] = {}
+    for spec, design in pairs:
+        per_program.setdefault(spec.name, (spec, []))[1].append(design)
+    work = {name: len(spec.words) * spec.frames * pixels for name, (spec, _) in per_program.items()}
+    tasks = []
+    for name, (spec, designs) in per_program.items():
+        size = max(1, min(BATCH, BATCH_WORK // max(1, work[name])))
+        tasks += [(spec, tuple(designs[k:k + size])) for k in range(0, len(designs), size)]
+    return sorted(tasks, key=lambda task: -work[task[0].name])  # stable: ties keep their order
 
 
 def design_cost(precision: str) -> Resources:

@@ -108,7 +108,7 @@ def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str
     """
     from ..campaign.runner import Campaign
     from ..fileio import Outputs
-    from .campaign import REFERENCE, design_cost, render_and_score, render_design
+    from .campaign import REFERENCE, batches, design_cost, render_design, score_designs
     from .report import Results, pareto_svg, results_csv, summary_md
     from .search import check_ladder, greedy, search_summary
 
@@ -130,19 +130,21 @@ def explore_command(programs: tuple[Path, ...], out_dir: Path, formats: list[str
         options = {"subnormals": subnormals, "width": width, "height": height, "jobs": jobs}
         scores: dict[tuple[str, str], Score] = {}
         with Campaign(scheduler) as campaign:
-            with Progress(len(specs), "explore: fp64", quiet=quiet) as bar:
+            with Progress(len(specs), "explore: fp64", quiet=quiet) as bar:  # kept on the workers that render them
                 references = campaign.map(partial(render_design, precision=REFERENCE, **options),
-                                          [(s,) for s in specs], [f"{s.name} in {REFERENCE}" for s in specs], bar)
+                                          [(s,) for s in specs], [f"{s.name} in {REFERENCE}" for s in specs], bar,
+                                          keep=True)
             reference = {s.name: r for s, r in zip(specs, references)}
 
             def evaluate(designs: list[str]) -> dict[str, list[Score]]:
                 """Every program in every design not scored yet; the scores of ``designs``."""
-                pairs = [(s, d) for d in dict.fromkeys(designs) for s in specs if (s.name, d) not in scores]
-                with Progress(len(pairs), "explore", quiet=quiet) as bar:
-                    found = campaign.map(partial(render_and_score, **options),
-                                         [(s, d, reference[s.name]) for s, d in pairs],
-                                         [f"{s.name} in {d}" for s, d in pairs], bar)
-                scores.update(((s.name, d), score) for (s, d), score in zip(pairs, found))
+                tasks = batches([(s, d) for d in dict.fromkeys(designs) for s in specs if (s.name, d) not in scores],
+                                width * height)
+                with Progress(len(tasks), "explore", quiet=quiet) as bar:
+                    found = campaign.map(partial(score_designs, **options),
+                                         [(s, ds, reference[s.name]) for s, ds in tasks],
+                                         [f"{s.name} in {', '.join(ds)}" for s, ds in tasks], bar)
+                scores.update(((s.name, d), score) for (s, ds), batch in zip(tasks, found) for d, score in zip(ds, batch))
                 return {d: [scores[s.name, d] for s in specs] for d in designs}
 
             if search:

@@ -140,6 +140,7 @@ _PLAIN = {
     "have_avx2": (c_int32, []),
     "bound_primary": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_void_p]),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
+    "table_write": (c_int64, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_int64]),
 }
 
 

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..isa import Table, lookup
 from ..isa.tables import LIGHT_INDEX_LIMIT, PROP_LIMIT
+from . import native
 
 
 def prop_index(table: Table, name: str) -> int:
@@ -49,13 +50,20 @@ class ObjectTable:
         return len(self.index)
 
     def update(self, index: np.ndarray, prop: np.ndarray, value: np.ndarray) -> None:
-        """Write ``value`` to ``(index, prop)`` in array order (the last write wins); every
-        index given is touched, so it gets a row."""
+        """Write ``value`` to ``(index, prop)`` in array order (the last write wins, in the
+        compiled loop of csrc/kernels.c table_write); every index given is touched, so it
+        gets a row."""
         if not len(index):
             return
-        cell = self._rows(index) * PROP_LIMIT + prop
-        last = _last(cell, self.values.size)
-        self.values.reshape(-1)[cell[last]] = value[last]
+        rows = self._rows(index)
+        prop = np.ascontiguousarray(prop, np.int64)
+        value = np.ascontiguousarray(value, np.uint16)
+        if not len(rows) == len(prop) == len(value):
+            raise ValueError("update: index, prop and value differ in length")
+        done = native.library().table_write(native.ptr(self.values, np.uint16, (None, PROP_LIMIT)), len(self.values),
+                                            rows.ctypes.data, prop.ctypes.data, value.ctypes.data, len(rows))
+        if done != len(rows):
+            raise ValueError(f"update: property {int(prop[done])} of write {done} is outside 0..{PROP_LIMIT - 1}")
 
     def _rows(self, index: np.ndarray) -> np.ndarray:
         """The row of each element of ``index``, adding zero rows for new indices.

@@ -115,7 +115,8 @@ static inline double depth_floor(double smin, double smax, double dist, double d
     double c_lo = 2.0 * (s_lo * s_lo - 1.0) - 8.0 * uu * (s_hi * s_hi + 1.0);
     if (!(c_lo > 0))
         return 0.0;
-    double alpha = pow(1.0 + uu, 4), beta = pow(1.0 - uu, 4), ac = 2.0 * (1.0 - 4.0 * uu) * c_lo;
+    double up2 = (1.0 + uu) * (1.0 + uu), down2 = (1.0 - uu) * (1.0 - uu);  /* products, not pow(): the */
+    double alpha = up2 * up2, beta = down2 * down2, ac = 2.0 * (1.0 - 4.0 * uu) * c_lo;  /* slack covers their ulps */
     double d_lo = dlo * (1.0 - e);
     double b_min = sqrt(fmax(0.0, ((1.0 - uu) * ac - tiny / (d_lo * d_lo)) / (1.0 + uu)));
     if (!(b_min > 0))
@@ -125,7 +126,7 @@ static inline double depth_floor(double smin, double smax, double dist, double d
     double t_lo = (1.0 - uu) * (1.0 - uu) * fmin(g_min, g_max) / a_hi / (smax * (1.0 + e));
     if (!(t_lo >= 2.0 * sqrt(tiny) * dmax))
         return 0.0;
-    double floor = pow(1.0 - uu, 6) * (1.0 - 4.0 * uu) * t_lo * t_lo * (1.0 - BOUND_SLACK);
+    double floor = beta * down2 * (1.0 - 4.0 * uu) * t_lo * t_lo * (1.0 - BOUND_SLACK);
     return isfinite(floor) ? floor : 0.0;
 }
 

@@ -294,6 +294,24 @@ void bound_primary(const double *bnd, const double *radius, int64_t n, const dou
     }
 }
 
+/* ---- the scene's object tables ---- */
+
+/* Writes in program order to a table of rows x 32 property words (rend3r/emu/scene.py
+ * ObjectTable.update): word prop[k] of row row[k] becomes value[k], so the last write to
+ * a word wins. Returns n, or the first write whose row or property lies outside the table
+ * (then nothing is written). */
+int64_t table_write(uint16_t *values, int64_t rows, const int64_t *row, const int64_t *prop,
+                    const uint16_t *value, int64_t n)
+{
+    for (int64_t k = 0; k < n; k++) {
+        if (row[k] < 0 || row[k] >= rows || prop[k] < 0 || prop[k] >= 32)
+            return k;
+    }
+    for (int64_t k = 0; k < n; k++)
+        values[32 * row[k] + prop[k]] = value[k];
+    return n;
+}
+
 /* ---- rounding, for tests ---- */
 
 void round16_array(const float *in, float *out, int64_t n, int32_t ftz)

@@ -141,6 +141,7 @@ _PLAIN = {
     "bound_primary": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_void_p]),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
     "table_write": (c_int64, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_int64]),
+    "pair_writes": (c_int64, [c_void_p, c_int64, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p]),
 }
 
 

@@ -30,6 +30,7 @@ from ..isa.tables import (
     DATA, FUNC, LIGHT_INDEX, OPCODE, PROP, PROP_LIMIT, SD_DATA, SD_DATA2, SE_INDEX_HI, SE_INDEX_LO, SE_PROP2, Field,
     Func, Opcode,
 )
+from . import native
 from .options import EmuOptions
 from .scene import Scene
 
@@ -215,11 +216,7 @@ class _Stream:
 
     def _pair_writes(self, entry: int) -> tuple[_Writes, _Writes]:
         """Each pair writes prop then prop2: two writes at the SE's address."""
-        at = self._data(_SE)
-        se, sd = self.prog.words[at], self.prog.words[at + 1]
-        index = (_get(se, SE_INDEX_HI).astype(np.int64) << SE_INDEX_LO.width) | _get(se, SE_INDEX_LO)
-        writes = _Writes(_twice(at), _twice(index), _pair(_get(se, PROP), _get(se, SE_PROP2)),
-                         _pair(_get(sd, SD_DATA), _get(sd, SD_DATA2)).astype(np.uint16))
+        writes = _decode_pairs(self.prog.words, self._data(_SE))
         table = self._tables(writes.at, entry)
         keep = ~_SE_NULL.reshape(-1)[(table - 1) * PROP_LIMIT + writes.prop]
         if self.prog.options.mode != "hybrid":
@@ -236,16 +233,23 @@ class _Stream:
         return np.where(codes == 0, entry, codes)
 
 
-def _twice(a: np.ndarray) -> np.ndarray:
-    """Each element twice in a row (one per write of a pair)."""
-    return _pair(a, a)
+#: (lo, width) of the fields pair_writes reads, in its order (csrc/kernels.c).
+_PAIR_FIELDS = np.array([(f.lo, f.width) for f in (SE_INDEX_HI, SE_INDEX_LO, PROP, SE_PROP2, SD_DATA, SD_DATA2)],
+                        np.int64)
 
 
-def _pair(first: np.ndarray, second: np.ndarray) -> np.ndarray:
-    """Interleaved: first[0], second[0], first[1], ..."""
-    out = np.empty((len(first), 2), dtype=np.result_type(first, second))
-    out[:, 0], out[:, 1] = first, second
-    return out.reshape(-1)
+def _decode_pairs(words: np.ndarray, at: np.ndarray) -> _Writes:
+    """The two writes of each SE/SD pair whose SE is at an address of ``at`` (prop then
+    prop2, both at the SE's address), decoded in one compiled pass (csrc/kernels.c
+    pair_writes; the addresses are checked there)."""
+    words = np.ascontiguousarray(words, np.uint32)
+    at = np.ascontiguousarray(at, np.int64)
+    out = [np.empty(2 * len(at), np.int64) for _ in range(3)] + [np.empty(2 * len(at), np.uint16)]
+    done = native.library().pair_writes(words.ctypes.data, len(words), at.ctypes.data, len(at),
+                                        _PAIR_FIELDS.ctypes.data, *(a.ctypes.data for a in out))
+    if done != len(at):
+        raise Rend3rError(f"{_where(int(at[done]))}: an SE word without its SD")
+    return _Writes(*out)
 
 
 @dataclass(frozen=True)

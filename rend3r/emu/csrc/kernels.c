@@ -312,6 +312,32 @@ int64_t table_write(uint16_t *values, int64_t rows, const int64_t *row, const in
     return n;
 }
 
+/* The writes of SE/SD pairs (rend3r/emu/processor.py _pair_writes): for the pair whose SE
+ * word is at address at[k] (its SD at at[k] + 1, both checked against n_words), writes 2k
+ * and 2k + 1 are (at, index, prop, data) and (at, index, prop2, data2). fields holds
+ * (lo, width) of SE_INDEX_HI, SE_INDEX_LO, PROP, SE_PROP2, SD_DATA, SD_DATA2 from
+ * rend3r/isa/tables.py. Returns n, or the first pair whose address is outside the words
+ * (then the outputs are incomplete). */
+int64_t pair_writes(const uint32_t *words, int64_t n_words, const int64_t *at, int64_t n, const int64_t *fields,
+                    int64_t *at_out, int64_t *index_out, int64_t *prop_out, uint16_t *data_out)
+{
+#define FIELD(w, f) (uint32_t)(((uint64_t)(w) >> fields[2 * (f)]) & ((1ull << fields[2 * (f) + 1]) - 1ull))
+    for (int64_t k = 0; k < n; k++) {
+        if (at[k] < 0 || at[k] + 1 >= n_words)
+            return k;
+        uint32_t se = words[at[k]], sd = words[at[k] + 1];
+        int64_t index = ((int64_t)FIELD(se, 0) << fields[3]) | FIELD(se, 1);
+        at_out[2 * k] = at_out[2 * k + 1] = at[k];
+        index_out[2 * k] = index_out[2 * k + 1] = index;
+        prop_out[2 * k] = FIELD(se, 2);
+        prop_out[2 * k + 1] = FIELD(se, 3);
+        data_out[2 * k] = (uint16_t)FIELD(sd, 4);
+        data_out[2 * k + 1] = (uint16_t)FIELD(sd, 5);
+    }
+#undef FIELD
+    return n;
+}
+
 /* ---- rounding, for tests ---- */
 
 void round16_array(const float *in, float *out, int64_t n, int32_t ftz)

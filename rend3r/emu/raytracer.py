@@ -9,9 +9,7 @@ not depend on it). Per band:
 1. the primary directions' shortest and longest length (``directions`` stores a rotated
    camera's directions);
 2. the shape hierarchy's boxes for the primary rays, from the shapes' cull radii and
-   depth floors (:mod:`.bvh`, :mod:`.bounds`; the tree itself is built once per frame,
-   and bands side by side share one set of boxes for the frame's rays unless the camera
-   is rotated);
+   depth floors (:mod:`.bvh`, :mod:`.bounds`; the tree itself is built once per frame);
 3. the nearest hit of every pixel, its hit point and normal (``nearest``, packets of a
    row's pixels walking the tree nearest node first);
 4. per light, the hierarchy's boxes for its shadow rays, then the light's colour with
@@ -101,14 +99,9 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
             bands[0] = (*bands[0], None)
         else:  # bands on the threads, their work single-threaded
             one = replace(fr, jobs=1)
-            # the primary rays' bounds once, on every thread, for the whole frame's rays: a
-            # superset of each band's, so they hold for every band (None: a rotated camera,
-            # whose bands measure their own directions)
-            extent = _extent(fr, 0, h)
-            primary = _primary_tree(fr, *extent) if extent is not None else None
             bands = [(row0, row1, threads.submit(fr.jobs, _band, one, options, row0, row1,
                                                  rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
-                                                 prov[row0 * w:row1 * w], primary)) for row0, row1 in bands]
+                                                 prov[row0 * w:row1 * w])) for row0, row1 in bands]
         for row0, row1, future in bands:
             _add(st, future.result() if future is not None else _band(
                 fr, options, row0, row1, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w], prov[row0 * w:row1 * w]))
@@ -263,10 +256,8 @@ _BAND_COUNTS = ("tests", "skipped", "nan_tests", "nan_rays", "hits", "shadow_ray
 
 
 def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray, depth: np.ndarray,
-          prov: np.ndarray, primary: tuple[bvh.Bounds, np.ndarray, np.ndarray] | None = None) -> FrameStats:
-    """Render rows row0..row1 into the band's slices of the frame; returns its counts.
-    ``primary``: the primary rays' bounds (_primary_tree) for rays including the band's,
-    else the band computes its own."""
+          prov: np.ndarray) -> FrameStats:
+    """Render rows row0..row1 into the band's slices of the frame; returns its counts."""
     st = FrameStats()
     w, n_pix, n, dtype = options.width, (row1 - row0) * options.width, len(fr.sf), fr.dtype
     lit = bool(fr.lights)
@@ -279,16 +270,14 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
                        native.ptr(fr.xs, dtype, (w,)), native.ptr(fr.ys, dtype, (options.height,)),
                        int(fr.rotated), int(lit), w, row0, native.row_magic(w))
     band.npix = n_pix
-    if primary is None:
-        extent = _extent(fr, row0, row1)
-        if extent is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
-            a["dirs"] = np.empty((n_pix, 4), dtype)
-            band.dirs = a["dirs"].ctypes.data
-            parts = _run(fr.jobs, n_pix, fr.kernel("directions"), band, np.array([0.0, np.inf, 0.0]))
-            extent = (float(parts[:, 1].min()), float(parts[:, 2].max())) if parts[:, 0].sum() else (0.0, 0.0)
-        primary = _primary_tree(fr, *extent)
-    tree, floor, pc = primary
-    band.pc, band.floor, band.tree = pc.ctypes.data, floor.ctypes.data, tree.struct()
+    extent = _extent(fr, row0, row1)
+    if extent is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
+        a["dirs"] = np.empty((n_pix, 4), dtype)
+        band.dirs = a["dirs"].ctypes.data
+        parts = _run(fr.jobs, n_pix, fr.kernel("directions"), band, np.array([0.0, np.inf, 0.0]))
+        extent = (float(parts[:, 1].min()), float(parts[:, 2].max())) if parts[:, 0].sum() else (0.0, 0.0)
+    primary, floor, pc = _primary_tree(fr, *extent)
+    band.pc, band.floor, band.tree = pc.ctypes.data, floor.ctypes.data, primary.struct()
     for name in ("slot", "sqd", "pt", "nm", "bad", "nan_px"):
         setattr(band, name, a[name].ctypes.data)
     c = _report(_run(fr.jobs, row1 - row0, fr.kernel("nearest"), band, _OUT, max(1, MIN_CHUNK // w)))

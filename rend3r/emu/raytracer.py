@@ -74,7 +74,6 @@ class _Frame:
     shapes: native.Shapes
     tree: bvh.Tree
 
-
     def kernel(self, name: str):
         """The compiled kernel ``name`` for this frame's precision."""
         return native.kernel(name, self.ar)

@@ -28,6 +28,7 @@ REFERENCE = "fp64"
 #: running, waits for one render at most.
 BATCH, BATCH_WORK = 4, 1 << 26
 
+
 @dataclass(frozen=True)
 class ProgramSpec:
     """A loaded program: its words, the mode it renders in and the frames to render."""

@@ -30,10 +30,8 @@
  * (as many roundings of its own u). T infinite: no limit. */
 static inline double product_limit(double overflow, double u)
 {
-    double limit = overflow / 4.0 * 1.02 / ((1.0 - 0.015625) * (1.0 - 0.015625));
-    if (u > 0x1p-11)
-        limit *= pow(1.02 / ((1.0 - 0.015625) * (1.0 - 0.015625)), u * 0x1p11 - 1.0);
-    return limit;
+    double slack = 1.02 / ((1.0 - 0.015625) * (1.0 - 0.015625));
+    return overflow / 4.0 * (u > 0x1p-11 ? pow(slack, u * 0x1p11) : slack);
 }
 
 /* dist bounds the distance from the rays' origins to the centre, dmin the rays' direction

@@ -283,7 +283,7 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
     st.tests += int(c[native.OUT_TESTS])
     st.nan_tests += int(c[native.OUT_NAN_TESTS])
     st.skipped += n_pix * n - int(c[native.OUT_TESTS])
-    acc = np.empty((n_pix if lit else 0, 3))  # the first light pass sets it
+    acc = np.empty((3, n_pix if lit else 0))  # colour sums per channel; the first light pass sets them
     for k in range(len(fr.lights)):
         _light(fr, options, k, band, c, acc, st)
     st.hits += fr.kernel("finish")(byref(band), acc.ctypes.data, fr.index.ctypes.data, options.background, 0, n_pix,
@@ -327,7 +327,7 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
     nearest-hit pass's report, with the box of the band's hit points)."""
     light = fr.light_rows[k]
     colour = fr.lights[k].color
-    n_pix, n = len(acc), len(fr.sf)
+    n_pix, n = acc.shape[1], len(fr.sf)
     shadows = n > 1
     point = light[native.LT_KIND] == native.LIGHT_POINT
     lp = native.LightPass(pointer(fr.shapes), pointer(band), native.ptr(light, fr.dtype, (native.LT_COLUMNS,)),
@@ -428,7 +428,7 @@ def _behind_terms(fr: _Frame, radius: np.ndarray, light: np.ndarray) -> np.ndarr
     smin, smax = fr.bnd[:, native.B_SMIN], fr.bnd[:, native.B_SMAX]
     with np.errstate(all="ignore"):
         uu = fr.ar.unit_roundoff + fr.ar.tiny / np.minimum(1.0, (smin * length) ** 2)
-        out = np.stack([fr.bnd[:, :3] @ unit,
+        out = np.stack([fr.bnd[:, 0] * unit[0] + fr.bnd[:, 1] * unit[1] + fr.bnd[:, 2] * unit[2],  # not BLAS
                         (smax**2 + smin**2) / 2, (smax**2 - smin**2) / 2 + 64.0 * uu * smax**2], axis=1)
     out[~(radius < np.inf)] = np.nan
     return np.ascontiguousarray(out)

@@ -111,7 +111,7 @@ typedef struct {            /* one light over one band */
     Bvh tree;               /* the shapes, with these shadow rays' boxes */
     const double *keys;     /* directional light (else NULL): per node the largest stop keys below it
                                (kernels.c behind_keys, bvh_keys) */
-    double *acc;            /* pixels x 3 colour sums */
+    double *acc;            /* 3 x pixels colour sums (red row, green row, blue row) */
 } LightPass;
 
 /* The row within its band of pixel p: (p * row_magic) >> 40 equals p / width exactly for

@@ -9,6 +9,7 @@
 #define REND3R_SIMD_H
 
 #include <stdint.h>
+#include <string.h>
 
 /* Helpers of the kernels are inlined whatever their size: they pass vectors and structs
  * of vectors, which a call would spill to memory. */
@@ -21,10 +22,16 @@ typedef double f64x4 __attribute__((vector_size(32)));
 typedef uint64_t u64x4 __attribute__((vector_size(32)));
 typedef int64_t i64x4 __attribute__((vector_size(32)));
 typedef int32_t i32x4 __attribute__((vector_size(16)));
+typedef uint32_t u32x4 __attribute__((vector_size(16)));
+typedef float f32x4 __attribute__((vector_size(16)));
+typedef uint16_t u16x4 __attribute__((vector_size(8)));
 
 /* Lanes 4h..4h+3 of a float packet, in double. */
 #define F32_HALF(v, h) __builtin_convertvector(                                                    \
     (h) == 0 ? __builtin_shufflevector((v), (v), 0, 1, 2, 3) : __builtin_shufflevector((v), (v), 4, 5, 6, 7), f64x4)
+/* Lanes 4h..4h+3 of an eight-lane float mask, as a four-lane double mask. */
+#define I32_HALF(m, h) __builtin_convertvector(                                                    \
+    (h) == 0 ? __builtin_shufflevector((m), (m), 0, 1, 2, 3) : __builtin_shufflevector((m), (m), 4, 5, 6, 7), i64x4)
 /* Two four-lane double masks as one eight-lane float mask. */
 #define MASK_8(lo, hi) __builtin_shufflevector(__builtin_convertvector((lo), i32x4),                \
                                                __builtin_convertvector((hi), i32x4), 0, 1, 2, 3, 4, 5, 6, 7)
@@ -32,15 +39,80 @@ typedef int32_t i32x4 __attribute__((vector_size(16)));
 /* Lanes of mask m: from a where set, else from b (integer vectors of one type). */
 #define SEL_BITS(m, a, b) (((a) & (m)) | ((b) & ~(m)))
 
+/* n consecutive doubles (n <= 4; the last repeated past n), and back. */
+INLINE f64x4 load4(const double *a, int n)
+{
+    f64x4 v;
+    if (n == 4) {
+        memcpy(&v, a, sizeof v);
+        return v;
+    }
+    for (int i = 0; i < 4; i++)
+        v[i] = a[i < n ? i : n - 1];
+    return v;
+}
+
+INLINE void store4(double *a, f64x4 v, int n)
+{
+    if (n == 4) {
+        memcpy(a, &v, sizeof v);
+        return;
+    }
+    if (n > 0)  /* lane by lane: a loop here becomes a call to memcpy */
+        a[0] = v[0];
+    if (n > 1)
+        a[1] = v[1];
+    if (n > 2)
+        a[2] = v[2];
+}
+
+/* Flags (bytes that are 0 or 1) as the bits of an int, byte i giving bit i: one
+ * multiplication gathers them into the top byte; and bits back to flags (each byte selects
+ * its bit, and adding 0x7F carries a set bit into the byte's top bit). */
+INLINE int flag_bits8(const uint8_t *a)
+{
+    uint64_t x;
+    memcpy(&x, a, sizeof x);
+    return (int)((x * 0x0102040810204080ull) >> 56);
+}
+
+INLINE int flag_bits4(const uint8_t *a)
+{
+    uint32_t x;
+    memcpy(&x, a, sizeof x);
+    return (int)((x * 0x01020408u) >> 24);
+}
+
+INLINE void put_flags8(uint8_t *a, int bits)
+{
+    uint64_t x = ((uint64_t)bits * 0x0101010101010101ull) & 0x8040201008040201ull;
+    x = ((x + 0x7F7F7F7F7F7F7F7Full) >> 7) & 0x0101010101010101ull;
+    memcpy(a, &x, sizeof x);
+}
+
+INLINE void put_flags4(uint8_t *a, int bits)
+{
+    uint32_t x = ((uint32_t)bits * 0x01010101u) & 0x08040201u;
+    x = ((x + 0x7F7F7F7Fu) >> 7) & 0x01010101u;
+    memcpy(a, &x, sizeof x);
+}
+
+/* A mask whose lane i is set where bit i of bits is. */
+INLINE i32x8 bits_mask_32x8(int bits) { return ((i32x8){1, 2, 4, 8, 16, 32, 64, 128} & bits) != 0; }
+INLINE i32x4 bits_mask_32x4(int bits) { return ((i32x4){1, 2, 4, 8} & bits) != 0; }
+INLINE i64x4 bits_mask_64x4(int bits) { return ((i64x4){1, 2, 4, 8} & bits) != 0; }
+
 /* The sign bits of a mask's lanes as an int (lane i: bit i); masks are all ones or zero
  * per lane. One instruction with AVX (the AVX2 kernels), two with SSE2. */
 #if defined(__AVX__)
 #include <immintrin.h>
 INLINE int mask_bits_32x8(i32x8 m) { return _mm256_movemask_ps((__m256)m); }
+INLINE int mask_bits_32x4(i32x4 m) { return _mm_movemask_ps((__m128)m); }
 INLINE int mask_bits_64x4(i64x4 m) { return _mm256_movemask_pd((__m256d)m); }
 #elif defined(__SSE2__)
 #include <emmintrin.h>
 typedef int64_t i64x2 __attribute__((vector_size(16)));
+INLINE int mask_bits_32x4(i32x4 m) { return _mm_movemask_ps((__m128)m); }
 INLINE int mask_bits_32x8(i32x8 m)
 {
     return _mm_movemask_ps((__m128)__builtin_shufflevector(m, m, 0, 1, 2, 3))
@@ -52,6 +124,13 @@ INLINE int mask_bits_64x4(i64x4 m)
          | _mm_movemask_pd((__m128d)__builtin_shufflevector(m, m, 2, 3)) << 2;
 }
 #else
+INLINE int mask_bits_32x4(i32x4 m)
+{
+    int r = 0;
+    for (int i = 0; i < 4; i++)
+        r |= (m[i] < 0) << i;
+    return r;
+}
 INLINE int mask_bits_32x8(i32x8 m)
 {
     int r = 0;

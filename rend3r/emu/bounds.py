@@ -19,46 +19,56 @@ SLACK = 1e-9
 SHAPE_CHUNK = 1 << 10
 
 
-def cull_radii(table: np.ndarray, ok: np.ndarray, dist: np.ndarray, dmin: float, u: float, tiny: float,
-               overflow: float, jobs: int = 1) -> np.ndarray:
-    """Per shape, the world radius beyond which no ray line can hit (inf: no bound): rays
-    whose origins lie within ``dist`` (per shape) of the centre, directions at least
-    ``dmin`` long, unit roundoff ``u``, smallest normal ``tiny`` and overflow threshold
-    ``overflow`` of the precision."""
-    out = np.empty(len(table))
-    table, flags, dist = _inputs(table, ok, dist)
+def primary(table: np.ndarray, ok: np.ndarray, apex: np.ndarray, dmin: float, dmax: float, u: float, tiny: float,
+            overflow: float, jobs: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per shape, for rays from ``apex`` with directions ``dmin``..``dmax`` long: the world
+    radius beyond which no ray line can hit (inf: no bound), a lower bound of the computed
+    ``sq_dist`` of any hit (0: none) and the cull data of the kernels' per-packet test
+    (``csrc/kernels.h`` PC_COLUMNS); ``u``, ``tiny`` and ``overflow`` are the precision's
+    unit roundoff, smallest normal and overflow threshold."""
+    n = len(table)
+    table, flags = _inputs(table, ok)
+    apex = np.ascontiguousarray(apex, np.float64)
+    native.ptr(apex, np.float64, (3,))
+    radius, floor, pc = np.empty(n), np.empty(n), np.empty((n, native.PC_COLUMNS))
     lib = native.library()
-    threads.split(jobs, threads.ranges(len(out), jobs, SHAPE_CHUNK), lambda a, b: lib.bound_radii(
-        table[a:].ctypes.data, flags[a:].ctypes.data, dist[a:].ctypes.data, b - a, dmin, u, tiny, overflow,
-        out[a:].ctypes.data))
-    return out
+    threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: lib.primary_shapes(
+        table[a:].ctypes.data, flags[a:].ctypes.data, b - a, apex.ctypes.data, dmin, dmax, u, tiny, overflow,
+        radius[a:].ctypes.data, floor[a:].ctypes.data, pc[a:].ctypes.data))
+    return radius, floor, pc
 
 
-def depth_floors(table: np.ndarray, ok: np.ndarray, dist: np.ndarray, dmin: float, dmax: float, u: float,
-                 tiny: float, jobs: int = 1) -> np.ndarray:
-    """Per shape, a lower bound of the computed ``sq_dist`` of any hit by a ray from an apex
-    ``dist`` (per shape) from the centre, directions between ``dmin`` and ``dmax`` long; 0:
-    no bound claimed."""
-    out = np.empty(len(table))
-    table, flags, dist = _inputs(table, ok, dist)
+def shadow(table: np.ndarray, ok: np.ndarray, lo: np.ndarray, hi: np.ndarray, dmin: float, u: float, tiny: float,
+           overflow: float, *, chord: float = np.nan, unit: np.ndarray | None = None, length: float = 0.0,
+           jobs: int = 1) -> tuple[np.ndarray, np.ndarray | None]:
+    """Per shape, the cull radius of shadow rays from origins in the box ``lo``..``hi``
+    with directions at least ``dmin`` long, widened by the origins' rounding and, for a
+    point light, by ``chord`` (the largest turn of a rounded l off the line to the light);
+    for a directional light along the unit vector ``unit`` (|l| = ``length``), also the
+    behind terms (n, 3) of the light pass's per-packet test (``csrc/kernels.h``
+    LightPass.behind), else None."""
+    n = len(table)
+    table, flags = _inputs(table, ok)
+    with np.errstate(all="ignore"):
+        mid = np.ascontiguousarray((lo + hi) / 2, np.float64)
+        half = float(np.sqrt(((hi - lo) ** 2).sum()) / 2)
+        magnitude = float(max(np.abs(lo).max(), np.abs(hi).max()))  # of any origin's coordinates
+    if unit is not None:
+        unit = np.ascontiguousarray(unit, np.float64)
+        native.ptr(unit, np.float64, (3,))
+    radius, behind = np.empty(n), np.empty((n if unit is not None else 0, 3))
     lib = native.library()
-    threads.split(jobs, threads.ranges(len(out), jobs, SHAPE_CHUNK), lambda a, b: lib.bound_floors(
-        table[a:].ctypes.data, flags[a:].ctypes.data, dist[a:].ctypes.data, b - a, dmin, dmax, u, tiny,
-        out[a:].ctypes.data))
-    return out
+    threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: lib.shadow_shapes(
+        table[a:].ctypes.data, flags[a:].ctypes.data, b - a, mid.ctypes.data, half, magnitude, dmin, chord, u, tiny,
+        overflow, None if unit is None else unit.ctypes.data, length, radius[a:].ctypes.data,
+        behind[a:].ctypes.data))
+    return radius, behind if unit is not None else None
 
 
-def _inputs(table: np.ndarray, ok: np.ndarray, dist: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The per-shape inputs as the kernels read them (checked table, uint8 flags, float64)."""
+def _inputs(table: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The per-shape inputs as the kernels read them (checked table, uint8 flags)."""
     n = len(table)
     native.ptr(table, np.float64, (n, native.B_COLUMNS))
-    dist = np.ascontiguousarray(dist, np.float64)
-    native.ptr(dist, np.float64, (n,))
-    return table, np.ascontiguousarray(ok, np.uint8), dist
-
-
-def reach(points: np.ndarray, centers: np.ndarray) -> np.ndarray:
-    """An upper bound of the distance from each centre to any of the points (n, 3)."""
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    mid, half = (lo + hi) / 2, np.linalg.norm(hi - lo) / 2
-    return np.linalg.norm(centers - mid, axis=1) * (1 + SLACK) + half
+    flags = np.ascontiguousarray(ok, np.uint8)
+    native.ptr(flags, np.uint8, (n,))
+    return table, flags

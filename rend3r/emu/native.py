@@ -33,7 +33,8 @@ CAM_ORIGIN, CAM_TMIN, CAM_TMAX, CAM_Z, CAM_ROT, CAM_COLUMNS = 0, 3, 4, 5, 6, 10
 LT_KIND, LT_LOC, LT_DIR, LT_INTENSITY, LT_COLUMNS = 0, 1, 4, 7, 8
 LIGHT_DIRECTIONAL, LIGHT_POINT = 1, 2
 TRACE_SHAPE_VALUES, TRACE_LIGHT_VALUES = 22, 12
-OUT_TESTS, OUT_NAN_TESTS, OUT_SHADOW_RAYS, OUT_HITS, OUT_LO, OUT_HI, OUT_COLUMNS = 0, 1, 2, 3, 4, 7, 10
+OUT_TESTS, OUT_NAN_TESTS, OUT_SHADOW_RAYS, OUT_HITS, OUT_LO, OUT_HI = 0, 1, 2, 3, 4, 7
+OUT_SHOWN, OUT_NAN_RAYS, OUT_COLUMNS = 10, 11, 12
 PC_COLUMNS = 7
 BVH_CONE, BVH_FLAT = 0, 1  # a hierarchy's bounds around lines through one apex, or parallel lines
 BV_ANGLE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 4, 5, 6  # their columns (csrc/kernels.h)
@@ -80,15 +81,16 @@ class Band(Structure):
                 ("rotated", c_int32), ("lit", c_int32), ("width", c_int64), ("row0", c_int64), ("row_magic", c_uint64),
                 ("dirs", c_void_p), ("pc", c_void_p), ("floor", c_void_p), ("tree", Bvh),
                 ("slot", c_void_p), ("sqd", c_void_p),
-                ("pt", c_void_p), ("nm", c_void_p), ("npix", c_int64), ("bad", c_void_p), ("nan_px", c_void_p)]
+                ("pt", c_void_p), ("nm", c_void_p), ("npix", c_int64), ("bad", c_void_p), ("nan_px", c_void_p),
+                ("acc", c_void_p), ("index", c_void_p), ("background", c_int32), ("rgb", c_void_p),
+                ("depth", c_void_p), ("prov", c_void_p)]
 
 
 class LightPass(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("band", POINTER(Band)), ("light", c_void_p), ("scale", c_double * 3),
                 ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
-                ("first", c_int32), ("along", c_void_p), ("behind", c_void_p), ("l_hat", c_double * 3),
-                ("l_len", c_double), ("radius", c_void_p), ("tree", Bvh), ("keys", c_void_p),
-                ("acc", c_void_p)]
+                ("first", c_int32), ("last", c_int32), ("along", c_void_p), ("behind", c_void_p),
+                ("l_hat", c_double * 3), ("l_len", c_double), ("radius", c_void_p), ("tree", Bvh), ("keys", c_void_p)]
 
 
 #: Pixels a band may hold and the widest frame, for Band.row_magic (csrc/kernels.h band_row).
@@ -126,19 +128,18 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
     "shadow_origins": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
     "trace_pixel": (c_int64, [POINTER(Band), c_int32, c_int32, c_void_p, c_void_p, c_int64, c_int64, c_int64,
                               c_void_p, c_void_p, c_void_p]),
-    "finish": (c_int64, [POINTER(Band), c_void_p, c_void_p, c_int32, c_int64, c_int64, c_void_p, c_void_p,
-                         c_void_p]),
+    "finish": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
 }
 _PLAIN = {
     "behind_keys": (None, [c_void_p, c_void_p, c_int64, c_double, c_void_p]),
     "bvh_keys": (None, [POINTER(Bvh), c_void_p, c_void_p]),
     "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p]),
     "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_void_p, c_void_p, c_int32, c_void_p, c_void_p]),
-    "bound_radii": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double, c_void_p]),
-    "bound_floors": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_double, c_double, c_double, c_double,
-                            c_void_p]),
+    "primary_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,
+                              c_void_p, c_void_p, c_void_p]),
+    "shadow_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,
+                             c_double, c_double, c_void_p, c_double, c_void_p, c_void_p]),
     "have_avx2": (c_int32, []),
-    "bound_primary": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_void_p]),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
     "table_write": (c_int64, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_int64]),
     "pair_writes": (c_int64, [c_void_p, c_int64, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p]),

@@ -14,7 +14,7 @@ not depend on it). Per band:
    row's pixels walking the tree nearest node first);
 4. per light, the hierarchy's boxes for its shadow rays, then the light's colour with
    its shadow rays (``light_pass``);
-5. colours, depth and provenance (``finish``).
+5. colours, depth and provenance (``finish``, in the last light's pass when there are lights).
 
 ``docs/emulator.md`` sections 4-7 give the order of operations and why the hierarchy
 never changes a pixel; :mod:`.reference` is the plain renderer the tests compare with.
@@ -22,6 +22,7 @@ never changes a pixel; :mod:`.reference` is the plain renderer the tests compare
 
 from __future__ import annotations
 
+import math
 from ctypes import byref, pointer
 from dataclasses import dataclass, replace
 from time import perf_counter
@@ -264,6 +265,7 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
         "slot": np.empty(n_pix, np.int32), "sqd": np.empty(n_pix, dtype),
         "pt": np.empty((3, n_pix if lit else 0), dtype), "nm": np.empty((3, n_pix if lit else 0), dtype),
         "bad": np.empty(n_pix, np.uint8), "nan_px": np.empty(n_pix, np.uint8),  # nearest sets every pixel
+        "acc": np.empty((3, n_pix if lit else 0)),  # colour sums per channel; the first light pass sets them
     }
     band = native.Band(pointer(fr.shapes), native.ptr(fr.cam, dtype, (native.CAM_COLUMNS,)),
                        native.ptr(fr.xs, dtype, (w,)), native.ptr(fr.ys, dtype, (options.height,)),
@@ -277,19 +279,21 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
         extent = (float(parts[:, 1].min()), float(parts[:, 2].max())) if parts[:, 0].sum() else (0.0, 0.0)
     primary, floor, pc = _primary_tree(fr, *extent)
     band.pc, band.floor, band.tree = pc.ctypes.data, floor.ctypes.data, primary.struct()
-    for name in ("slot", "sqd", "pt", "nm", "bad", "nan_px"):
+    for name in ("slot", "sqd", "pt", "nm", "bad", "nan_px", "acc"):
         setattr(band, name, a[name].ctypes.data)
+    band.index, band.background = fr.index.ctypes.data, options.background
+    band.rgb, band.depth = native.ptr(rgb, np.uint16, (n_pix,)), native.ptr(depth, np.float32, (n_pix,))
+    band.prov = native.ptr(prov, np.int32, (n_pix,))
     c = _report(_run(fr.jobs, row1 - row0, fr.kernel("nearest"), band, _OUT, max(1, MIN_CHUNK // w)))
     st.tests += int(c[native.OUT_TESTS])
     st.nan_tests += int(c[native.OUT_NAN_TESTS])
     st.skipped += n_pix * n - int(c[native.OUT_TESTS])
-    acc = np.empty((3, n_pix if lit else 0))  # colour sums per channel; the first light pass sets them
-    for k in range(len(fr.lights)):
-        _light(fr, options, k, band, c, acc, st)
-    st.hits += fr.kernel("finish")(byref(band), acc.ctypes.data, fr.index.ctypes.data, options.background, 0, n_pix,
-                                   native.ptr(rgb, np.uint16, (n_pix,)), native.ptr(depth, np.float32, (n_pix,)),
-                                   native.ptr(prov, np.int32, (n_pix,)))
-    st.nan_rays += int(a["nan_px"].sum())
+    for k in range(len(fr.lights)):  # the last light's pass finishes the pixels
+        done = _light(fr, options, k, band, c, n_pix, st)
+    if not lit:
+        done = _report(_run(fr.jobs, n_pix, fr.kernel("finish"), band, _OUT))
+    st.hits += int(done[native.OUT_SHOWN])
+    st.nan_rays += int(done[native.OUT_NAN_RAYS])
     return st
 
 
@@ -308,32 +312,26 @@ def _extent(fr: _Frame, row0: int, row1: int) -> tuple[float, float] | None:
 def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> tuple[bvh.Bounds, np.ndarray, np.ndarray]:
     """The hierarchy's bounds for the primary rays (directions dmin..dmax long), and per
     shape its depth floor and cull data."""
-    apex = fr.cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)
-    bounded = fr.bounded & bool(np.isfinite(apex).all())
-    with np.errstate(all="ignore"):  # a camera at infinity: nothing is bounded
-        dist = _lengths(fr.bnd[:, :3] - apex)
-    u, tiny = fr.ar.unit_roundoff, fr.ar.tiny
-    radius = bounds.cull_radii(fr.bnd, bounded, dist, dmin, u, tiny, fr.ar.overflow, fr.jobs)
-    floor = bounds.depth_floors(fr.bnd, bounded, dist, dmin, dmax, u, tiny, fr.jobs)
-    pc = np.empty((len(radius), native.PC_COLUMNS))
-    native.library().bound_primary(fr.bnd.ctypes.data, radius.ctypes.data, len(radius), apex.ctypes.data, dmin, u,
-                                   tiny, pc.ctypes.data)
+    apex = fr.cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)  # at infinity: nothing is bounded
+    radius, floor, pc = bounds.primary(fr.bnd, fr.bounded, apex, dmin, dmax, fr.ar.unit_roundoff, fr.ar.tiny,
+                                       fr.ar.overflow, fr.jobs)
     return fr.tree.refit(fr.bnd, radius, floor, apex=apex), floor, pc
 
 
-def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.ndarray, acc: np.ndarray,
-           st: FrameStats) -> None:
+def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.ndarray, n_pix: int,
+           st: FrameStats) -> np.ndarray:
     """Add light ``k`` to the band's colour sums, with its shadow rays (``hits``: the
-    nearest-hit pass's report, with the box of the band's hit points)."""
+    nearest-hit pass's report, with the box of the band's hit points); returns the pass's
+    report (the last light's finishes the pixels)."""
     light = fr.light_rows[k]
     colour = fr.lights[k].color
-    n_pix, n = acc.shape[1], len(fr.sf)
+    n = len(fr.sf)
     shadows = n > 1
     point = light[native.LT_KIND] == native.LIGHT_POINT
     lp = native.LightPass(pointer(fr.shapes), pointer(band), native.ptr(light, fr.dtype, (native.LT_COLUMNS,)),
                           (*[((colour >> shift) & top) / top for shift, top in _CHANNELS],))
-    lp.fixed, lp.shadows, lp.parallel, lp.acc = int(options.intensity_fixed), int(shadows), int(not point), acc.ctypes.data
-    lp.first = int(k == 0)
+    lp.fixed, lp.shadows, lp.parallel = int(options.intensity_fixed), int(shadows), int(not point)
+    lp.first, lp.last = int(k == 0), int(k == len(fr.lights) - 1)
     if shadows:  # lp points into the arrays of sb: they live until the pass is done
         sb = _shadow_bounds(fr, lp, light, hits, n_pix)
         lp.tree, lp.radius, lp.along = sb.bounds.struct(), sb.radius.ctypes.data, sb.along.ctypes.data
@@ -346,6 +344,7 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
     st.nan_tests += int(c[native.OUT_NAN_TESTS])
     if shadows:
         st.skipped += int(c[native.OUT_SHADOW_RAYS]) * (n - 1) - int(c[native.OUT_TESTS])
+    return c
 
 
 #: shadow_origins' output: bounding box of the points, largest magnitude, largest chord,
@@ -371,32 +370,26 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
     directional light's also get the behind terms and stop keys, so a packet skips whole
     subtrees lying behind its origins."""
     n = len(fr.sf)
-    centers = fr.bnd[:, :3]
     if not hits[native.OUT_HITS]:
         return _unbounded(fr, lp)
     lo, hi = hits[native.OUT_LO:native.OUT_LO + 3], hits[native.OUT_HI:native.OUT_HI + 3]
-    magnitude = max(np.abs(lo).max(), np.abs(hi).max())  # of any hit point's coordinates
-    u, tiny = fr.ar.unit_roundoff, fr.ar.tiny
-    with np.errstate(all="ignore"):
-        mid, half = (lo + hi) / 2, np.sqrt(((hi - lo) ** 2).sum()) / 2
-        far = _lengths(centers - mid) * (1 + bounds.SLACK) + half  # to any origin, at most
-        slack = 1e-12 * (_lengths(centers) + magnitude)
+    limits = (fr.ar.unit_roundoff, fr.ar.tiny, fr.ar.overflow)
     if not lp.parallel:  # a point light: the rounding of l turns each ray off the line to the light
         apex = light[native.LT_LOC:native.LT_LOC + 3].astype(np.float64)
         origins = _report_origins(_run(fr.jobs, n_pix, fr.kernel("shadow_origins"), lp, _ORIGINS))
         if not origins[8]:
             return _unbounded(fr, lp)
         bounded = fr.bounded & bool(np.isfinite(apex).all())
-        radius = bounds.cull_radii(fr.bnd, bounded, far, float(origins[9]), u, tiny, fr.ar.overflow, fr.jobs)
-        radius += far * (origins[7] * (1 + bounds.SLACK) + 1e-15) + slack
+        radius, _ = bounds.shadow(fr.bnd, bounded, lo, hi, float(origins[9]), *limits, chord=float(origins[7]),
+                                  jobs=fr.jobs)
         return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex), np.zeros((0, 4), fr.dtype))
     length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
         return _unbounded(fr, lp)
-    radius = bounds.cull_radii(fr.bnd, fr.bounded, far, length, u, tiny, fr.ar.overflow, fr.jobs) + slack
+    radius, behind = bounds.shadow(fr.bnd, fr.bounded, lo, hi, length, *limits, unit=unit, length=length,
+                                   jobs=fr.jobs)
     along = np.empty((n, 4), fr.dtype)
     fr.kernel("shadow_directions")(byref(fr.shapes), light.ctypes.data, along.ctypes.data)
-    behind = _behind_terms(fr, radius, light)
     lib, keys = native.library(), np.empty((n, 3))
     lib.behind_keys(behind.ctypes.data, radius.ctypes.data, n, length, keys.ctypes.data)
     flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit))
@@ -420,20 +413,6 @@ def _unit(v: np.ndarray) -> tuple[float, np.ndarray]:
         return length, v / length
 
 
-def _behind_terms(fr: _Frame, radius: np.ndarray, light: np.ndarray) -> np.ndarray:
-    """Per shape, what the light pass's per-packet behind test needs (csrc/kernels.h
-    LightPass.behind): the centre's depth along l, mean2 and spread2 + 64 uu smax^2 of
-    misses4's behind test (uu at |l|, the one direction length); NaN without a radius."""
-    length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
-    smin, smax = fr.bnd[:, native.B_SMIN], fr.bnd[:, native.B_SMAX]
-    with np.errstate(all="ignore"):
-        uu = fr.ar.unit_roundoff + fr.ar.tiny / np.minimum(1.0, (smin * length) ** 2)
-        out = np.stack([fr.bnd[:, 0] * unit[0] + fr.bnd[:, 1] * unit[1] + fr.bnd[:, 2] * unit[2],  # not BLAS
-                        (smax**2 + smin**2) / 2, (smax**2 - smin**2) / 2 + 64.0 * uu * smax**2], axis=1)
-    out[~(radius < np.inf)] = np.nan
-    return np.ascontiguousarray(out)
-
-
 def _report_origins(outs: np.ndarray) -> np.ndarray:
     """shadow_origins' chunks merged: boxes joined, counts summed, extremes kept."""
     out = _ORIGINS.copy()
@@ -442,14 +421,11 @@ def _report_origins(outs: np.ndarray) -> np.ndarray:
     return out
 
 
-def _lengths(v: np.ndarray) -> np.ndarray:
-    """The length of each row of ``v`` (n, 3) (einsum: numpy's reductions along a short
-    axis are several times slower)."""
-    return np.sqrt(np.einsum("ij,ij->i", v, v))
-
-
 def _normal_plane(d: np.ndarray) -> np.ndarray:
-    """Two orthonormal vectors (2, 3) normal to the unit vector d."""
-    e1 = np.cross(d, [1.0, 0.0, 0.0] if abs(d[0]) < 0.9 else [0.0, 1.0, 0.0])
-    e1 /= np.linalg.norm(e1)
-    return np.stack([e1, np.cross(d, e1)])
+    """Two orthonormal vectors (2, 3) normal to the unit vector d (plain arithmetic:
+    numpy's cross product costs tens of microseconds on 3-vectors)."""
+    x, y, z = (float(c) for c in d)
+    e = (0.0, z, -y) if abs(x) < 0.9 else (-z, 0.0, x)  # d x (1, 0, 0) or d x (0, 1, 0)
+    norm = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+    e = (e[0] / norm, e[1] / norm, e[2] / norm)
+    return np.array([e, (y * e[2] - z * e[1], z * e[0] - x * e[2], x * e[1] - y * e[0])])

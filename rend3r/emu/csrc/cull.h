@@ -1,7 +1,7 @@
 /* The cull tests of bounds.h for four rays at once (double lanes).
  *
  * primary_cull4: rays from the camera, against one shape's primary cull data (pc, see
- *   bound_primary): off the line, or behind the camera.
+ *   primary_shapes in kernels.c): off the line, or behind the camera.
  * misses4: rays with their own origins (shadow rays), against one shape's centre and cull
  *   radius: off the line, or the shape behind the origin.
  * A set lane means "provably no hit"; NaN anywhere leaves the lane clear.

@@ -31,8 +31,11 @@ enum { PC_V = 0, PC_VV = 3, PC_R2 = 4, PC_MEAN2 = 5, PC_BEHIND = 6, PC_COLUMNS =
 /* Values per shape and per light in a pixel trace. */
 enum { TRACE_SHAPE_VALUES = 22, TRACE_LIGHT_VALUES = 12 };
 /* What a kernel reports per chunk (double): tests, tests that met NaN or infinity, shadow
- * rays, hit pixels with a finite hit point and those points' bounding box. */
-enum { OUT_TESTS = 0, OUT_NAN_TESTS = 1, OUT_SHADOW_RAYS = 2, OUT_HITS = 3, OUT_LO = 4, OUT_HI = 7, OUT_COLUMNS = 10 };
+ * rays, hit pixels with a finite hit point and those points' bounding box; and once the
+ * pixels are finished, those shown (not the background) and those whose rays met NaN or
+ * infinity. */
+enum { OUT_TESTS = 0, OUT_NAN_TESTS = 1, OUT_SHADOW_RAYS = 2, OUT_HITS = 3, OUT_LO = 4, OUT_HI = 7, OUT_SHOWN = 10,
+       OUT_NAN_RAYS = 11, OUT_COLUMNS = 12 };
 
 /* A working format eEmM of the _fmt kernels (csrc/fformat.h; native.py Format). */
 typedef struct {
@@ -92,6 +95,12 @@ typedef struct {            /* the primary rays of one band of rows */
     int64_t npix;           /* pixels of the band */
     uint8_t *bad;           /* hit point, or later a light, not finite */
     uint8_t *nan_px;        /* a ray of the pixel met NaN or infinity */
+    double *acc;            /* 3 x pixels colour sums (red row, green row, blue row; lit only) */
+    const int32_t *index;   /* program index per shape slot (provenance) */
+    int32_t background;     /* RGB565 of pixels that show no shape */
+    uint16_t *rgb;          /* the band's pixels: RGB565, depth, provenance */
+    float *depth;
+    int32_t *prov;
 } Band;
 
 typedef struct {            /* one light over one band */
@@ -103,6 +112,7 @@ typedef struct {            /* one light over one band */
     int32_t shadows;        /* cast shadow rays (there are other shapes) */
     int32_t parallel;       /* directional light: per-shape terms in along */
     int32_t first;          /* the band's first light: it sets the colour sums instead of adding */
+    int32_t last;           /* the band's last light: its pass also finishes the pixels */
     const void *along;      /* n x 4: l in normal space and a2, working (directional) */
     const double *behind;   /* n x 3 (directional): centre . l/|l|, and the behind test's mean2
                                and (spread2 + 64 uu smax^2), NaN where no test applies */
@@ -111,7 +121,6 @@ typedef struct {            /* one light over one band */
     Bvh tree;               /* the shapes, with these shadow rays' boxes */
     const double *keys;     /* directional light (else NULL): per node the largest stop keys below it
                                (kernels.c behind_keys, bvh_keys) */
-    double *acc;            /* 3 x pixels colour sums (red row, green row, blue row) */
 } LightPass;
 
 /* The row within its band of pixel p: (p * row_magic) >> 40 equals p / width exactly for

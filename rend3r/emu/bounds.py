@@ -14,7 +14,6 @@ import numpy as np
 
 from . import native, threads
 
-SLACK = 1e-9
 #: Shapes a thread takes at least.
 SHAPE_CHUNK = 1 << 10
 

@@ -110,6 +110,10 @@ class Campaign:
         from ..emu.threads import available_cores
         from ..svo.interrupt import ctrl_c_ignored
 
+        # Dask's own logs (a closed comm's traceback as a cluster stops, at INFO) are not ours
+        # to show: LocalCluster's silence_logs covers only its start, so they are silenced for
+        # the process; failures reach the user as rend3r's errors.
+        logging.getLogger("distributed").setLevel(logging.CRITICAL)
         try:
             if self.scheduler == LOCAL:
                 slots = self.workers or available_cores()

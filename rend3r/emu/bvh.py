@@ -79,4 +79,6 @@ def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
     items = np.flatnonzero(inside).astype(np.int32)
     node = np.empty((max(1, 2 * len(items)), 2), np.int32)
     count = native.library().bvh_build(bnd.ctypes.data, items.ctypes.data, len(items), node.ctypes.data)
+    if count < 0:
+        raise MemoryError(f"no memory to build the shape hierarchy of {len(items):,} shapes")
     return Tree(np.ascontiguousarray(node[:count]), items, np.flatnonzero(~inside).astype(np.int32))

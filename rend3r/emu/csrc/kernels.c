@@ -12,6 +12,8 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "bounds.h"
 #include "bvh.h"
@@ -35,19 +37,23 @@ int32_t have_avx2(void)
 
 /* ---- the shape hierarchy (rend3r/emu/bvh.py, csrc/bvh.h) ---- */
 
-/* Reorders items[lo..hi) so that items[k] has the centre coordinate `axis` that sorting
- * would give it, none before it larger and none after it smaller (quickselect). */
-static void select_nth(const double *bnd, int32_t *items, int64_t lo, int64_t hi, int64_t k, int axis)
+/* A shape while the hierarchy is built: its centre in float (the tree's shape decides only
+ * how fast rays find their shapes, never what they hit) and its slot, packed so that the
+ * splits walk one small array instead of following slots into the bound table. */
+typedef struct { float c[3]; int32_t slot; } BuildItem;
+
+/* Reorders a[lo..hi) so that a[k] has the centre coordinate `axis` that sorting would give
+ * it, none before it larger and none after it smaller (quickselect). */
+static void select_nth(BuildItem *a, int64_t lo, int64_t hi, int64_t k, int axis)
 {
-#define KEY(i) bnd[B_COLUMNS * (int64_t)items[i] + axis]
     while (hi - lo > 1) {
-        double pivot = KEY(lo + (hi - lo) / 2);
+        float pivot = a[lo + (hi - lo) / 2].c[axis];
         int64_t i = lo, j = hi - 1;
         while (i <= j) {
-            while (KEY(i) < pivot) i++;
-            while (KEY(j) > pivot) j--;
+            while (a[i].c[axis] < pivot) i++;
+            while (a[j].c[axis] > pivot) j--;
             if (i <= j) {
-                int32_t t = items[i]; items[i] = items[j]; items[j] = t;
+                BuildItem t = a[i]; a[i] = a[j]; a[j] = t;
                 i++; j--;
             }
         }
@@ -55,18 +61,25 @@ static void select_nth(const double *bnd, int32_t *items, int64_t lo, int64_t hi
         else if (k >= i) lo = i;
         else return;
     }
-#undef KEY
 }
 
 /* The hierarchy over the n shapes items (slots into bnd, whose centres are finite):
  * median splits of each node's shapes across the longest side of their centres' box,
  * leaves of at most BVH_LEAF. items is reordered leaf by leaf; node (2 ints per node, room
- * for 2n nodes) gets the nodes depth first. Returns the node count. */
+ * for 2n nodes) gets the nodes depth first. Returns the node count, or -1 when the
+ * working copy cannot be allocated. */
 int64_t bvh_build(const double *bnd, int32_t *items, int64_t n, int32_t *node)
 {
     int64_t stack[4 * BVH_STACK], top = 1, count = 0;
     if (n <= 0)
         return 0;
+    BuildItem *a = malloc((size_t)n * sizeof *a);
+    if (a == NULL)
+        return -1;
+    for (int64_t i = 0; i < n; i++) {
+        const double *c = bnd + B_COLUMNS * (int64_t)items[i];
+        a[i] = (BuildItem){{(float)c[0], (float)c[1], (float)c[2]}, items[i]};
+    }
     /* pending ranges: lo, hi, the parent whose right child it is (-1: none), depth */
     stack[0] = 0; stack[1] = n; stack[2] = -1; stack[3] = 0;
     while (top > 0) {
@@ -80,22 +93,23 @@ int64_t bvh_build(const double *bnd, int32_t *items, int64_t n, int32_t *node)
             node[2 * at + 1] = (int32_t)(hi - lo);
             continue;
         }
-        double bl[3] = {INFINITY, INFINITY, INFINITY}, bh[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (int64_t i = lo; i < hi; i++) {
-            const double *c = bnd + B_COLUMNS * (int64_t)items[i];
-            for (int k = 0; k < 3; k++) { bl[k] = MIN(bl[k], c[k]); bh[k] = MAX(bh[k], c[k]); }
-        }
+        float bl[3] = {INFINITY, INFINITY, INFINITY}, bh[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int64_t i = lo; i < hi; i++)
+            for (int k = 0; k < 3; k++) { bl[k] = MIN(bl[k], a[i].c[k]); bh[k] = MAX(bh[k], a[i].c[k]); }
         int axis = 0;
         for (int k = 1; k < 3; k++)
             if (bh[k] - bl[k] > bh[axis] - bl[axis])
                 axis = k;
         int64_t mid = lo + (hi - lo) / 2;
-        select_nth(bnd, items, lo, hi, mid, axis);
+        select_nth(a, lo, hi, mid, axis);
         node[2 * at + 1] = 0;
         int64_t right[4] = {mid, hi, at, depth + 1}, left[4] = {lo, mid, -1, depth + 1};
         memcpy(stack + 4 * top++, right, sizeof right);  /* after the left subtree */
         memcpy(stack + 4 * top++, left, sizeof left);    /* the next node */
     }
+    for (int64_t i = 0; i < n; i++)
+        items[i] = a[i].slot;
+    free(a);
     return count;
 }
 

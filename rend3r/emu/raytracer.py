@@ -96,15 +96,19 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
             rows = min(rows, -(-h // fr.jobs))
         bands = [(row0, min(h, row0 + rows)) for row0 in range(0, h, rows)]
         if len(bands) == 1:
-            bands[0] = (*bands[0], None)
-        else:  # bands on the threads, their work single-threaded
+            work = [(*bands[0], fr, None)]
+        else:  # bands on the threads, their work single-threaded; with a band per thread at
+            # most, this thread renders the first (rather than wait) and the pool the others
             one = replace(fr, jobs=1)
-            bands = [(row0, row1, threads.submit(fr.jobs, _band, one, options, row0, row1,
-                                                 rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
-                                                 prov[row0 * w:row1 * w])) for row0, row1 in bands]
-        for row0, row1, future in bands:
+            own = len(bands) <= fr.jobs
+            pool = fr.jobs - 1 if own else fr.jobs
+            work = [(row0, row1, one, None if own and k == 0 else threads.submit(
+                pool, _band, one, options, row0, row1, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
+                prov[row0 * w:row1 * w])) for k, (row0, row1) in enumerate(bands)]
+        for row0, row1, frame, future in work:
             _add(st, future.result() if future is not None else _band(
-                fr, options, row0, row1, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w], prov[row0 * w:row1 * w]))
+                frame, options, row0, row1, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
+                prov[row0 * w:row1 * w]))
             if progress is not None:
                 progress(row1 / h)
     st.seconds = perf_counter() - start

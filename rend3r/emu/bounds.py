@@ -55,13 +55,13 @@ def shadow(table: np.ndarray, ok: np.ndarray, lo: np.ndarray, hi: np.ndarray, dm
     if unit is not None:
         unit = np.ascontiguousarray(unit, np.float64)
         native.ptr(unit, np.float64, (3,))
-    radius, behind = np.empty(n), np.empty((n if unit is not None else 0, 3))
+    radius, behind = np.empty(n), None if unit is None else np.empty((n, 3))
     lib = native.library()
     threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: lib.shadow_shapes(
         table[a:].ctypes.data, flags[a:].ctypes.data, b - a, mid.ctypes.data, half, magnitude, dmin, chord, u, tiny,
         overflow, None if unit is None else unit.ctypes.data, length, radius[a:].ctypes.data,
-        behind[a:].ctypes.data))
-    return radius, behind if unit is not None else None
+        None if behind is None else behind[a:].ctypes.data))
+    return radius, behind
 
 
 def _inputs(table: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import Rend3rError
 from . import native
 
 
@@ -80,5 +81,5 @@ def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
     node = np.empty((max(1, 2 * len(items)), 2), np.int32)
     count = native.library().bvh_build(bnd.ctypes.data, items.ctypes.data, len(items), node.ctypes.data)
     if count < 0:
-        raise MemoryError(f"no memory to build the shape hierarchy of {len(items):,} shapes")
+        raise Rend3rError(f"not enough memory to build the shape hierarchy of {len(items):,} shapes")
     return Tree(np.ascontiguousarray(node[:count]), items, np.flatnonzero(~inside).astype(np.int32))

@@ -86,6 +86,13 @@ class Band(Structure):
                 ("depth", c_void_p), ("prov", c_void_p)]
 
 
+class Pairs(Structure):
+    """SE/SD pairs for pair_marks and pair_apply (csrc/kernels.c Pairs)."""
+
+    _fields_ = [("words", c_void_p), ("n_words", c_int64), ("at", c_void_p), ("n", c_int64), ("fields", c_void_p),
+                ("tables", c_void_p), ("entry", c_int32), ("wanted", c_void_p), ("null", c_void_p)]
+
+
 class LightPass(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("band", POINTER(Band)), ("light", c_void_p), ("scale", c_double * 3),
                 ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
@@ -141,8 +148,10 @@ _PLAIN = {
                              c_double, c_double, c_void_p, c_double, c_void_p, c_void_p]),
     "have_avx2": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
-    "table_write": (c_int64, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_int64]),
-    "pair_writes": (c_int64, [c_void_p, c_int64, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p]),
+    "stream_scan": (None, [c_void_p, c_int64, c_int64, c_int32, c_int32, c_void_p, c_void_p, c_void_p, c_void_p,
+                           c_void_p, c_void_p]),
+    "pair_marks": (c_int64, [POINTER(Pairs), c_void_p]),
+    "pair_apply": (None, [POINTER(Pairs), c_void_p, c_void_p]),
 }
 
 

@@ -17,6 +17,7 @@ bound.
 from __future__ import annotations
 
 from array import array
+from ctypes import byref
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Callable, Sequence
@@ -27,12 +28,12 @@ from ..errors import Rend3rError
 from ..isa import Table, ValueType, by_index
 from ..isa.extensions import TS_CODES, decode_table_select, table_select_word
 from ..isa.tables import (
-    DATA, FUNC, LIGHT_INDEX, OPCODE, PROP, PROP_LIMIT, SD_DATA, SD_DATA2, SE_INDEX_HI, SE_INDEX_LO, SE_PROP2, Field,
-    Func, Opcode,
+    DATA, FUNC, LIGHT_INDEX, OPCODE, PROP, PROP_LIMIT, SD_DATA, SD_DATA2, SE_INDEX_HI, SE_INDEX_LO, SE_PROP2,
+    SHAPE_INDEX_LIMIT, Field, Func, Opcode,
 )
 from . import native
 from .options import EmuOptions
-from .scene import Scene
+from .scene import ObjectTable, Scene
 
 #: Called at each ``nf`` with the scene and the frame number (0-based).
 RenderHook = Callable[[Scene, int], None]
@@ -53,9 +54,7 @@ def _null_mask(table: Table) -> np.ndarray:
 
 
 _CAMERA_NULL, _LIGHT_NULL = _null_mask(Table.CAMERA), _null_mask(Table.LIGHT)
-_SE_NULL = np.stack([_null_mask(t) for t in _TABLES])  # row: table code - 1
-#: Per opcode value: True for C, L and SE (data words; the others are control words).
-_DATA_OPCODE = np.isin(np.arange(1 << OPCODE.width), (_C, _L, _SE))
+_SE_NULL = np.stack([_null_mask(t) for t in _TABLES]).astype(np.uint8)  # row: table code - 1
 
 
 @dataclass(frozen=True)
@@ -74,25 +73,6 @@ def _get(words: np.ndarray, f: Field) -> np.ndarray:
 
 def _where(pc: int) -> str:
     return f"address {pc} (0x{pc:04x})"
-
-
-def _starts(is_se: np.ndarray) -> np.ndarray:
-    """Which words start an instruction when a stream is read from its first word.
-
-    A word after a non-SE-opcode word always starts one; in a run of SE-opcode words the
-    starts alternate from the run's first word; an SE start takes the next word as its SD.
-    Only SE words that follow an SE word need the parity of their place in the run.
-    """
-    se_start = is_se.copy()
-    inner = np.flatnonzero(is_se[1:] & is_se[:-1]) + 1  # a run of k + 1 SE words has k of them, consecutive
-    if len(inner):
-        first = np.ones(len(inner), dtype=bool)
-        first[1:] = np.diff(inner) != 1
-        run_start = np.maximum.accumulate(np.where(first, inner - 1, 0))
-        se_start[inner] = (inner - run_start) % 2 == 0
-    starts = np.ones(len(is_se), dtype=bool)
-    starts[1:] = ~se_start[:-1]
-    return starts
 
 
 @dataclass(frozen=True)
@@ -118,14 +98,24 @@ class _Writes:
 
 
 class _Program:
-    """The words (uint32) and their opcodes, with the options that decide their meaning."""
+    """The words (uint32), with the options that decide their meaning."""
 
     def __init__(self, words: Sequence[int], options: EmuOptions) -> None:
         if not isinstance(words, np.ndarray):  # array("I") converts a list fastest
             words = np.frombuffer(array("I", words), dtype=np.uintc)
-        self.words = words.astype(np.uint32, copy=False)
-        self.op = _get(self.words, OPCODE).astype(np.uint8)
+        self.words = np.ascontiguousarray(words, np.uint32)
         self.options = options
+
+    def opcode(self, at: np.ndarray | int) -> np.ndarray:
+        """The opcode field of the words at ``at``."""
+        return _get(self.words[at], OPCODE)
+
+
+#: The lists stream_scan sorts instructions into (control words: F and unknown opcodes),
+#: and per opcode value its list.
+_CONTROL, _CAMERA, _LIGHT, _PAIR = range(4)
+_KIND = np.full(1 << OPCODE.width, _CONTROL, np.uint8)
+_KIND[[_C, _L, _SE]] = _CAMERA, _LIGHT, _PAIR
 
 
 class _Stream:
@@ -134,15 +124,18 @@ class _Stream:
 
     def __init__(self, prog: _Program, start: int) -> None:
         self.prog, self.start = prog, start
-        self.starts = start + np.flatnonzero(_starts(prog.op[start:] == _SE))
-        self.ops = prog.op[self.starts]
-        self._pairs: dict[int, tuple[_Writes, _Writes]] = {}
-        self._find_stop(self.starts[~_DATA_OPCODE[self.ops]])  # F words and unknown opcodes
+        room = max(0, len(prog.words) - start)
+        lists, count = [np.empty(room, np.int64) for _ in range(4)], np.zeros(4, np.int64)
+        native.library().stream_scan(prog.words.ctypes.data, len(prog.words), start, OPCODE.lo, OPCODE.width,
+                                     _KIND.ctypes.data, *(a.ctypes.data for a in lists), count.ctypes.data)
+        # Addresses of the instructions per kind (_KIND), in order; an SE's pair is one instruction.
+        self.by_kind = [a[:c] for a, c in zip(lists, count.tolist())]
+        self._find_stop(self.by_kind[_CONTROL])
 
     def _find_stop(self, control: np.ndarray) -> None:
         """Classify the control words: the nfs before ``stop``, the nrs, the TS words."""
         prog, n = self.prog, len(self.prog.words)
-        words, frame = prog.words[control], prog.op[control] == _F
+        words, frame = prog.words[control], prog.opcode(control) == _F
         func = np.where(frame, _get(words, FUNC), -1)
         nf, lr, self.nr, er = (control[func == int(f)] for f in (Func.NF, Func.LR, Func.NR, Func.ER))
         if prog.options.er_needs_zero:
@@ -152,8 +145,8 @@ class _Stream:
         # The table code after k TS words of the stream (k = 0: 0, the pass's entry table).
         self.ts_codes = np.append(0, 1 + np.argmax(words[ts][:, None] == _TS_WORDS, axis=1))
         errors = control[~frame & ~ts]
-        last = self.starts[-1:]
-        trailing = last[(last == n - 1) & (prog.op[last] == _SE)]
+        last = self.by_kind[_PAIR][-1:]
+        trailing = last[last == n - 1]  # an SE in the last word
         ends = [(int(a[0]), kind) for a, kind in ((lr, "lr"), (er, "er"), (errors, "error"), (trailing, "error"))
                 if len(a)]
         self.stop, self.kind = min(ends, default=(n, "end"))
@@ -161,12 +154,12 @@ class _Stream:
 
     def executed_before(self, address: int) -> int:
         """Instructions of this stream that start before ``address``."""
-        return int(np.searchsorted(self.starts, address))
+        return sum(int(np.searchsorted(a, address)) for a in self.by_kind)
 
     def error(self) -> Rend3rError:
         """The error at ``stop`` (kind "error")."""
         word = int(self.prog.words[self.stop])
-        if self.prog.op[self.stop] == _SE:
+        if self.prog.opcode(self.stop) == _SE:
             return Rend3rError(f"{_where(self.stop)}: SE word 0x{word:08x} is the last word; its SD is missing")
         hint = ("; it is a TS table-select word (docs/isa-extensions.md): run with --mode hybrid"
                 if decode_table_select(word) is not None else "")
@@ -188,18 +181,18 @@ class _Stream:
         """The table code in force at ``stop`` for a pass entered with ``entry``."""
         return int(self.ts_codes[np.searchsorted(self.ts_at, self.stop)]) or entry
 
-    def _data(self, opcode: int) -> np.ndarray:
-        """Addresses of the instructions with ``opcode`` before ``stop``."""
-        before = self.executed_before(self.stop)
-        return self.starts[:before][self.ops[:before] == opcode]
+    def _data(self, kind: int) -> np.ndarray:
+        """Addresses of the instructions of ``kind`` (_KIND) before ``stop``."""
+        at = self.by_kind[kind]
+        return at[:np.searchsorted(at, self.stop)]
 
     @cached_property
     def camera(self) -> _Writes:
-        return self._word_writes(self._data(_C), _CAMERA_NULL)
+        return self._word_writes(self._data(_CAMERA), _CAMERA_NULL)
 
     @cached_property
     def lights(self) -> _Writes:
-        return self._word_writes(self._data(_L), _LIGHT_NULL, LIGHT_INDEX)
+        return self._word_writes(self._data(_LIGHT), _LIGHT_NULL, LIGHT_INDEX)
 
     def _word_writes(self, at: np.ndarray, null: np.ndarray, index: Field | None = None) -> _Writes:
         words = self.prog.words[at]
@@ -207,49 +200,41 @@ class _Stream:
         idx = _get(words, index) if index is not None else np.zeros(len(at), dtype=np.uint32)
         return _Writes(at, idx, prop, _get(words, DATA).astype(np.uint16)).take(~null[prop])
 
-    def pairs(self, entry: int) -> tuple[_Writes, _Writes]:
-        """SE/SD writes before ``stop`` for a pass entered with table code ``entry``, null
-        properties dropped: (to ``scene.objects``, to ``scene.triangles``)."""
-        if entry not in self._pairs:
-            self._pairs[entry] = self._pair_writes(entry)
-        return self._pairs[entry]
-
-    def _pair_writes(self, entry: int) -> tuple[_Writes, _Writes]:
-        """Each pair writes prop then prop2: two writes at the SE's address."""
-        writes = _decode_pairs(self.prog.words, self._data(_SE))
-        table = self._tables(writes.at, entry)
-        keep = ~_SE_NULL.reshape(-1)[(table - 1) * PROP_LIMIT + writes.prop]
-        if self.prog.options.mode != "hybrid":
-            return writes.take(keep), writes.between(0, 0)  # (0, 0): none
-        triangle = table == _CODE[Table.TRIANGLE]
-        return writes.take(keep & ~triangle), writes.take(keep & triangle)
-
-    def _tables(self, at: np.ndarray, entry: int) -> np.ndarray:
-        """The table code in force at each address of ``at`` in a pass entered with
-        ``entry`` (one 0-d array when the stream has no TS word)."""
+    def pair_tables(self, at: np.ndarray) -> np.ndarray | None:
+        """The table code in force at each SE address of ``at`` (0: the pass's entry
+        table); None when the stream has no TS word."""
         if not len(self.ts_at):
-            return np.asarray(entry)
-        codes = self.ts_codes[np.searchsorted(self.ts_at, at)]
-        return np.where(codes == 0, entry, codes)
+            return None
+        return np.ascontiguousarray(self.ts_codes[np.searchsorted(self.ts_at, at)], np.uint8)
 
 
-#: (lo, width) of the fields pair_writes reads, in its order (csrc/kernels.c).
+#: (lo, width) of the fields the pair kernels read, in their order (csrc/kernels.c Pairs).
 _PAIR_FIELDS = np.array([(f.lo, f.width) for f in (SE_INDEX_HI, SE_INDEX_LO, PROP, SE_PROP2, SD_DATA, SD_DATA2)],
                         np.int64)
+#: Per table code, 1 where pairs go to (scene.objects, scene.triangles): in hybrid mode
+#: those aimed at the triangle table go to ``triangles``, else all go to ``objects``.
+_TRIANGLE_CODE = (np.arange(len(_TABLES) + 1) == _CODE[Table.TRIANGLE]).astype(np.uint8)
+_WANTED = {True: (1 - _TRIANGLE_CODE, _TRIANGLE_CODE),
+           False: (np.ones(len(_TABLES) + 1, np.uint8), np.zeros(len(_TABLES) + 1, np.uint8))}
 
 
-def _decode_pairs(words: np.ndarray, at: np.ndarray) -> _Writes:
-    """The two writes of each SE/SD pair whose SE is at an address of ``at`` (prop then
-    prop2, both at the SE's address), decoded in one compiled pass (csrc/kernels.c
-    pair_writes; the addresses are checked there)."""
-    words = np.ascontiguousarray(words, np.uint32)
-    at = np.ascontiguousarray(at, np.int64)
-    out = [np.empty(2 * len(at), np.int64) for _ in range(3)] + [np.empty(2 * len(at), np.uint16)]
-    done = native.library().pair_writes(words.ctypes.data, len(words), at.ctypes.data, len(at),
-                                        _PAIR_FIELDS.ctypes.data, *(a.ctypes.data for a in out))
-    if done != len(at):
-        raise Rend3rError(f"{_where(int(at[done]))}: an SE word without its SD")
-    return _Writes(*out)
+def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, entry: int, wanted: np.ndarray,
+                 table: ObjectTable) -> None:
+    """Apply the SE/SD pairs at ``at`` (each writes prop then prop2; a write to a null
+    property stores nothing) that ``wanted`` takes to ``table``, in two compiled passes
+    over the words (csrc/kernels.c pair_marks, pair_apply): the indices, then the writes."""
+    if not wanted.any():
+        return
+    pairs = native.Pairs(words.ctypes.data, len(words), at.ctypes.data, len(at), _PAIR_FIELDS.ctypes.data,
+                         None if tables is None else tables.ctypes.data, entry, wanted.ctypes.data,
+                         _SE_NULL.ctypes.data)
+    lib, mark = native.library(), np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
+    top = lib.pair_marks(byref(pairs), mark.ctypes.data)
+    if top < 0:
+        raise Rend3rError(f"{_where(int(at[-1 - top]))}: an SE word without its SD")
+    if top:
+        row_of = table.grow(mark, top)
+        lib.pair_apply(byref(pairs), row_of.ctypes.data, native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))
 
 
 @dataclass(frozen=True)
@@ -298,9 +283,12 @@ def _apply(stream: _Stream, lo: int, hi: int, scene: Scene, entry: int) -> None:
         scene.write_camera(camera.prop, camera.bits)
     if len(lights.at):
         scene.write_lights(lights.index, lights.prop, lights.bits)
-    for table, writes in zip((scene.objects, scene.triangles), stream.pairs(entry)):
-        w = writes.between(lo, hi)
-        table.update(w.index, w.prop, w.bits)
+    pairs = stream.by_kind[_PAIR]
+    at = pairs[np.searchsorted(pairs, lo):np.searchsorted(pairs, hi)]  # hi <= stop
+    if len(at):
+        tables = stream.pair_tables(at)
+        for table, wanted in zip((scene.objects, scene.triangles), _WANTED[stream.prog.options.mode == "hybrid"]):
+            _write_pairs(stream.prog.words, at, tables, entry, wanted, table)
 
 
 def _run_pass(stream: _Stream, scene: Scene, on_nf: RenderHook | None, count: int, frames: int | None,

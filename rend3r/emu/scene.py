@@ -14,8 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..isa import Table, lookup
-from ..isa.tables import LIGHT_INDEX_LIMIT, PROP_LIMIT
-from . import native
+from ..isa.tables import LIGHT_INDEX_LIMIT, PROP_LIMIT, SHAPE_INDEX_LIMIT
 
 
 def prop_index(table: Table, name: str) -> int:
@@ -49,37 +48,23 @@ class ObjectTable:
     def __len__(self) -> int:
         return len(self.index)
 
-    def update(self, index: np.ndarray, prop: np.ndarray, value: np.ndarray) -> None:
-        """Write ``value`` to ``(index, prop)`` in array order (the last write wins, in the
-        compiled loop of csrc/kernels.c table_write); every index given is touched, so it
-        gets a row."""
-        if not len(index):
-            return
-        rows = self._rows(index)
-        prop = np.ascontiguousarray(prop, np.int64)
-        value = np.ascontiguousarray(value, np.uint16)
-        if not len(rows) == len(prop) == len(value):
-            raise ValueError("update: index, prop and value differ in length")
-        done = native.library().table_write(native.ptr(self.values, np.uint16, (None, PROP_LIMIT)), len(self.values),
-                                            rows.ctypes.data, prop.ctypes.data, value.ctypes.data, len(rows))
-        if done != len(rows):
-            raise ValueError(f"update: property {int(prop[done])} of write {done} is outside 0..{PROP_LIMIT - 1}")
-
-    def _rows(self, index: np.ndarray) -> np.ndarray:
-        """The row of each element of ``index``, adding zero rows for new indices.
-
-        A dense map over the index range (no sort): SE indices have 19 bits.
-        """
-        slot = np.zeros(max(int(index.max()), int(self.index.max(initial=-1))) + 1, dtype=np.int64)
-        slot[self.index] = 1
-        slot[index] = 1
-        merged = np.flatnonzero(slot)
-        slot[merged] = np.arange(len(merged))
+    def grow(self, mark: np.ndarray, top: int) -> np.ndarray:
+        """Rows for the indices written: ``mark`` (uint8, one per index a shape can have,
+        SHAPE_INDEX_LIMIT) is 1 at each, all below ``top``. Adds a zero row for each new
+        index (a dense map over the index range: no sort) and returns the row of every
+        index below ``top`` that has one (int32; the others are undefined)."""
+        if mark.shape != (SHAPE_INDEX_LIMIT,) or mark.dtype != np.uint8:
+            raise ValueError(f"grow: the marks must be {SHAPE_INDEX_LIMIT} bytes")
+        top = max(top, int(self.index[-1]) + 1 if len(self.index) else 0)
+        mark[self.index] = 1
+        merged = np.flatnonzero(mark[:top])
+        row_of = np.empty(top, np.int32)
+        row_of[merged] = np.arange(len(merged), dtype=np.int32)
         if len(merged) > len(self.index):
             values = np.zeros((len(merged), PROP_LIMIT), dtype=np.uint16)
-            values[slot[self.index]] = self.values
+            values[row_of[self.index]] = self.values
             self.index, self.values = merged, values
-        return slot[index]
+        return row_of
 
     def row(self, index: int) -> dict[int, int]:
         """The non-zero property words of ``index`` (KeyError if it was never written)."""

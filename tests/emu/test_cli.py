@@ -187,10 +187,11 @@ def test_fuzz_option_values_exit_0_1_or_2_and_leave_nothing_on_failure(tmp_path,
     value = data.draw(OPTIONS[which])
     src = tmp_path / "s.asm"
     src.write_text(SRC)
-    out = tmp_path / "out"
-    out.mkdir(exist_ok=True)
-    for old in sorted(out.rglob("*"), reverse=True):
+    root = tmp_path / "w"  # a pattern climbs out of out at most three levels ("../../..")
+    out = root / "x" / "y" / "out"
+    for old in sorted(root.rglob("*"), reverse=True):
         old.unlink() if old.is_file() else old.rmdir()
+    out.mkdir(parents=True)
     if which in ("-o", "--depth-image", "--provenance"):
         value = f"{out}/{value}{'.npy' if which == '--depth-image' else '.png'}"
     if which == "--size" and not _small_enough(value):
@@ -200,7 +201,7 @@ def test_fuzz_option_values_exit_0_1_or_2_and_leave_nothing_on_failure(tmp_path,
     r = _run(src, *args, "--trace", out / "t.jsonl", "--frames", 1)
     assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
     assert r.exit_code in (0, 1, 2)
-    written = [p for p in out.rglob("*") if p.is_file()]
+    written = [p for p in root.rglob("*") if p.is_file()]
     if r.exit_code:
         assert "rend3r: error: " in r.output or "Error: " in r.output, r.output
         assert written == [] and list(out.iterdir()) == [], written

@@ -329,49 +329,128 @@ void shadow_shapes(const double *bnd, const uint8_t *ok, int64_t n, const double
     }
 }
 
-/* ---- the scene's object tables ---- */
+/* ---- the instruction processor (rend3r/emu/processor.py) ---- */
 
-/* Writes in program order to a table of rows x 32 property words (rend3r/emu/scene.py
- * ObjectTable.update): word prop[k] of row row[k] becomes value[k], so the last write to
- * a word wins. Returns n, or the first write whose row or property lies outside the table
- * (then nothing is written). */
-int64_t table_write(uint16_t *values, int64_t rows, const int64_t *row, const int64_t *prop,
-                    const uint16_t *value, int64_t n)
+/* The instructions met reading words linearly from address start (_Stream): an SE word
+ * takes the next word as its SD whatever that word is (an SE in the last word has none),
+ * any other word is one instruction. Each instruction's address goes to the list of its
+ * opcode's kind (kind[opcode]: 0 control words and unknown opcodes, 1 C, 2 L, 3 SE), in
+ * address order; count[kind] is how many each list got (room: n - start addresses each). */
+void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo, int32_t op_width,
+                 const uint8_t *kind, int64_t *control, int64_t *camera, int64_t *light, int64_t *pair,
+                 int64_t *count)
 {
-    for (int64_t k = 0; k < n; k++) {
-        if (row[k] < 0 || row[k] >= rows || prop[k] < 0 || prop[k] >= 32)
-            return k;
+    uint32_t mask = (1u << op_width) - 1u;
+    int64_t c[4] = {0, 0, 0, 0};
+    for (int64_t i = start; i < n;) {
+        switch (kind[(words[i] >> op_lo) & mask]) {
+        case 1: camera[c[1]++] = i++; break;
+        case 2: light[c[2]++] = i++; break;
+        case 3: pair[c[3]++] = i; i += 2; break;
+        default: control[c[0]++] = i++; break;
+        }
     }
-    for (int64_t k = 0; k < n; k++)
-        values[32 * row[k] + prop[k]] = value[k];
-    return n;
+    for (int k = 0; k < 4; k++)
+        count[k] = c[k];
 }
 
-/* The writes of SE/SD pairs (rend3r/emu/processor.py _pair_writes): for the pair whose SE
- * word is at address at[k] (its SD at at[k] + 1, both checked against n_words), writes 2k
- * and 2k + 1 are (at, index, prop, data) and (at, index, prop2, data2). fields holds
+/* The SE/SD pairs whose SE words are at at[0..n) (_apply), each writing (index, prop, data)
+ * then (index, prop2, data2) to the table of its table code t (tables[k], or entry where
+ * tables is NULL or tables[k] is 0); only pairs with wanted[t] are taken, and a write to a
+ * null property of the pair's table (null[32 (t - 1) + prop]) stores nothing. fields holds
  * (lo, width) of SE_INDEX_HI, SE_INDEX_LO, PROP, SE_PROP2, SD_DATA, SD_DATA2 from
- * rend3r/isa/tables.py. Returns n, or the first pair whose address is outside the words
- * (then the outputs are incomplete). */
-int64_t pair_writes(const uint32_t *words, int64_t n_words, const int64_t *at, int64_t n, const int64_t *fields,
-                    int64_t *at_out, int64_t *index_out, int64_t *prop_out, uint16_t *data_out)
+ * rend3r/isa/tables.py. */
+typedef struct {
+    const uint32_t *words;
+    int64_t n_words;
+    const int64_t *at;
+    int64_t n;
+    const int64_t *fields;
+    const uint8_t *tables;
+    int32_t entry;
+    const uint8_t *wanted;
+    const uint8_t *null;
+} Pairs;
+
+/* The pair fields' shifts and masks, in locals (the kernels' stores to bytes may alias
+ * anything, so fields read through p would be read again after each). */
+typedef struct {
+    uint32_t lo[6], mask[6], hi_shift;
+} PairFields;
+
+static inline PairFields pair_fields(const Pairs *p)
 {
-#define FIELD(w, f) (uint32_t)(((uint64_t)(w) >> fields[2 * (f)]) & ((1ull << fields[2 * (f) + 1]) - 1ull))
+    PairFields f;
+    for (int k = 0; k < 6; k++) {
+        f.lo[k] = (uint32_t)p->fields[2 * k];
+        f.mask[k] = (uint32_t)((1ull << p->fields[2 * k + 1]) - 1ull);
+    }
+    f.hi_shift = (uint32_t)p->fields[3];
+    return f;
+}
+
+#define FIELD(f, w, k) (((w) >> (f).lo[k]) & (f).mask[k])
+
+static inline int32_t pair_table(const uint8_t *tables, int32_t entry, int64_t k)
+{
+    return tables != NULL && tables[k] ? tables[k] : entry;
+}
+
+/* Marks the index of every pair taken that stores a word (mark[index] = 1; mark has 2^19
+ * entries, all an index can name). Returns the largest index marked + 1 (0 for none), or
+ * -1 - k for the first pair k whose SD lies outside the words (then nothing may be
+ * written). */
+int64_t pair_marks(const Pairs *p, uint8_t *mark)
+{
+    const uint32_t *words = p->words;
+    const int64_t *at = p->at;
+    const uint8_t *tables = p->tables, *wanted = p->wanted, *null = p->null;
+    int64_t n = p->n, n_words = p->n_words, top = 0;
+    int32_t entry = p->entry;
+    PairFields f = pair_fields(p);
     for (int64_t k = 0; k < n; k++) {
         if (at[k] < 0 || at[k] + 1 >= n_words)
-            return k;
-        uint32_t se = words[at[k]], sd = words[at[k] + 1];
-        int64_t index = ((int64_t)FIELD(se, 0) << fields[3]) | FIELD(se, 1);
-        at_out[2 * k] = at_out[2 * k + 1] = at[k];
-        index_out[2 * k] = index_out[2 * k + 1] = index;
-        prop_out[2 * k] = FIELD(se, 2);
-        prop_out[2 * k + 1] = FIELD(se, 3);
-        data_out[2 * k] = (uint16_t)FIELD(sd, 4);
-        data_out[2 * k + 1] = (uint16_t)FIELD(sd, 5);
+            return -1 - k;
     }
-#undef FIELD
-    return n;
+    for (int64_t k = 0; k < n; k++) {
+        int32_t table = pair_table(tables, entry, k);
+        uint32_t se = words[at[k]];
+        const uint8_t *nulls = null + 32 * (table - 1);
+        if (!wanted[table] || (nulls[FIELD(f, se, 2)] && nulls[FIELD(f, se, 3)]))
+            continue;
+        int64_t index = ((int64_t)FIELD(f, se, 0) << f.hi_shift) | FIELD(f, se, 1);
+        mark[index] = 1;
+        top = index >= top ? index + 1 : top;
+    }
+    return top;
 }
+
+/* Writes the pairs taken, in order, to a table of 32 property words per row (the last
+ * write to a word wins), row row_of[index]. pair_marks checked the addresses. */
+void pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values)
+{
+    const uint32_t *words = p->words;
+    const int64_t *at = p->at;
+    const uint8_t *tables = p->tables, *wanted = p->wanted, *null = p->null;
+    int64_t n = p->n;
+    int32_t entry = p->entry;
+    PairFields f = pair_fields(p);
+    for (int64_t k = 0; k < n; k++) {
+        int32_t table = pair_table(tables, entry, k);
+        if (!wanted[table])
+            continue;
+        uint32_t se = words[at[k]], sd = words[at[k] + 1];
+        int64_t index = ((int64_t)FIELD(f, se, 0) << f.hi_shift) | FIELD(f, se, 1);
+        uint16_t *row = values + 32 * (int64_t)row_of[index];
+        const uint8_t *nulls = null + 32 * (table - 1);
+        uint32_t prop = FIELD(f, se, 2), prop2 = FIELD(f, se, 3);
+        if (!nulls[prop])
+            row[prop] = (uint16_t)FIELD(f, sd, 4);
+        if (!nulls[prop2])
+            row[prop2] = (uint16_t)FIELD(f, sd, 5);
+    }
+}
+#undef FIELD
 
 /* ---- rounding, for tests ---- */
 

@@ -92,7 +92,7 @@ def emulate_command(program, output, frames, mode, precision, stage_precision, s
     from ..fileio import Outputs
     from .processor import execute
     from .quirks import apply_quirks, quirk_names
-    from .run import run_program
+    from .run import FRAME_BYTES_PER_PIXEL, run_program
     from .trace import parse_pixel
 
     if gif_path and apng_path:
@@ -180,7 +180,7 @@ def emulate_command(program, output, frames, mode, precision, stage_precision, s
         warnings.simplefilter("ignore", RuntimeWarning)
         with Progress(count * 1000, "rendering", quiet=quiet) as bar:
             result = run_program(loaded.words, options, frames, on_frame, progress, keep_frames=False,
-                                 on_scene=on_scene)
+                                 on_scene=on_scene, memory=budget - need + FRAME_BYTES_PER_PIXEL * options.pixels)
         if trace_path:
             outputs.write(trace_path, trace_buf.getvalue().encode())
         if animate:

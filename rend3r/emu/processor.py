@@ -321,6 +321,33 @@ def _replay(plan: _Plan, scene: Scene, on_nf: RenderHook | None, frames: int | N
         count, entry = _run_pass(stream, scene, on_nf, count, frames, entry)
 
 
+@dataclass(frozen=True)
+class Planned:
+    """A program whose control flow is validated: how it will run, and :meth:`replay`."""
+
+    execution: Execution
+    plan: _Plan
+    options: EmuOptions
+    frames: int | None
+
+    def replay(self, on_nf: RenderHook | None = None, scene: Scene | None = None) -> None:
+        """Apply the writes to ``scene`` (a new one if None), calling ``on_nf`` at each nf."""
+        entry = _CODE[Table.TRIANGLE if self.options.mode == "raster" else Table.SHAPE]
+        _replay(self.plan, scene if scene is not None else Scene(), on_nf, self.frames, entry)
+
+
+def plan(words: Sequence[int], options: EmuOptions, frames: int | None = None) -> Planned:
+    """Follow the control flow of ``words`` up to ``er``, the end, or ``frames`` frames.
+
+    Raises Rend3rError for an unknown opcode or trailing SE (with its address), for a
+    looping program without a ``frames`` bound, and for a loop that renders nothing.
+    """
+    if frames is not None and frames < 1:
+        raise Rend3rError(f"--frames must be at least 1, not {frames}")
+    flow = _plan(_Program(words, options), frames)
+    return Planned(flow.execution, flow, options, frames)
+
+
 def execute(
     words: Sequence[int],
     options: EmuOptions,
@@ -330,16 +357,11 @@ def execute(
 ) -> Execution:
     """Run ``words`` until ``er``, the end, or ``frames`` frames; call ``on_nf`` at each nf.
 
-    Raises Rend3rError for an unknown opcode or trailing SE (with its address), for a
-    looping program without a ``frames`` bound, and for a loop that renders nothing, all
-    before ``on_nf`` is first called. ``scene`` (if given) is left as the run left it.
-    Without ``on_nf`` and ``scene`` only the control flow is followed.
+    Every error of :func:`plan` is raised before ``on_nf`` is first called. ``scene`` (if
+    given) is left as the run left it. Without ``on_nf`` and ``scene`` only the control
+    flow is followed.
     """
-    if frames is not None and frames < 1:
-        raise Rend3rError(f"--frames must be at least 1, not {frames}")
-    prog = _Program(words, options)
-    plan = _plan(prog, frames)
+    planned = plan(words, options, frames)
     if on_nf is not None or scene is not None:
-        entry = _CODE[Table.TRIANGLE if options.mode == "raster" else Table.SHAPE]
-        _replay(plan, scene if scene is not None else Scene(), on_nf, frames, entry)
-    return plan.execution
+        planned.replay(on_nf, scene)
+    return planned.execution

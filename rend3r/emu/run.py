@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
+from collections import deque
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
+from time import perf_counter
 from typing import Callable, Sequence
 
 import numpy as np
 
 from .frame import Frame
 from .options import EmuOptions
-from .processor import execute
+from .processor import plan
 from .scene import Scene
-from .stats import RunStats
+from .stats import FrameStats, RunStats
+from .threads import available_cores
 
 FrameHook = Callable[[Frame], None]
 #: Called at each ``nf`` with the scene about to be rendered and the frame number.
@@ -48,6 +52,21 @@ def _renderer(options: EmuOptions):
     return render_frame
 
 
+#: Working memory of a frame in flight, per pixel, at most (every mode; the raytracer's band
+#: arrays take about 100 bytes), and what frames in flight may hold together by default.
+FRAME_BYTES_PER_PIXEL = 128
+FLIGHT_BYTES = 512 << 20
+
+
+def frames_at_once(options: EmuOptions, count: int, memory: int = FLIGHT_BYTES) -> int:
+    """How many of a run's ``count`` frames render side by side, each on one thread: one per
+    thread when the run has a frame for every thread and ``memory`` holds that many frames'
+    working arrays; else 1 (each frame then splits over the threads)."""
+    jobs = options.jobs or available_cores()
+    at_once = min(jobs, memory // (FRAME_BYTES_PER_PIXEL * options.pixels))
+    return at_once if 1 < jobs <= count and at_once > 1 else 1
+
+
 def run_program(
     words: Sequence[int],
     options: EmuOptions | None = None,
@@ -56,26 +75,28 @@ def run_program(
     progress: ProgressHook | None = None,
     keep_frames: bool = True,
     on_scene: SceneHook | None = None,
+    memory: int = FLIGHT_BYTES,
 ) -> RunResult:
     """Execute ``words``, rendering a frame at each ``nf`` (up to ``frames`` frames).
 
     The processor validates the control flow before the first frame, so decoding errors
     and unbounded loops are reported before any time is spent on frames.
     ``keep_frames=False`` leaves ``result.frames`` empty (use ``on_frame`` to consume
-    frames as they come).
-    ``on_scene`` sees each frame's scene (pixel traces use it).
+    frames as they come, in order). ``on_scene`` sees each frame's scene (pixel traces use
+    it). A run with a frame for every thread renders frames side by side (a copy of each
+    scene per thread, their working arrays within ``memory`` bytes); the frames are the same.
     """
+    start = perf_counter()
     options = options or EmuOptions()
     render = _renderer(options)
     result = RunResult()
-
+    planned = plan(words, options, frames)
+    at_once = frames_at_once(options, planned.execution.frames, memory)
+    one = replace(options, jobs=1)
     previous: list[Frame] = []
+    pending: deque[tuple[int, Future]] = deque()
 
-    def on_nf(scene: Scene, number: int) -> None:
-        hook = (lambda f: progress(number, f)) if progress is not None else None
-        if on_scene is not None:
-            on_scene(scene, number)
-        frame, st = render(scene, options, number, hook)
+    def deliver(frame: Frame, st: FrameStats) -> None:
         if options.mode == "raster" and not options.clear_frames and previous:
             kept = np.where(frame.provenance >= 0, frame.rgb565, previous[0].rgb565)
             frame = replace(frame, rgb565=kept.astype(np.uint16))
@@ -88,6 +109,31 @@ def run_program(
         if on_frame is not None:
             on_frame(frame)
 
-    ex = execute(words, options, frames, on_nf)
-    result.stats.instructions, result.stats.halt = ex.instructions, ex.halt
+    def oldest() -> None:
+        number, future = pending.popleft()
+        deliver(*future.result())
+        if progress is not None:
+            progress(number, 1.0)
+
+    def on_nf(scene: Scene, number: int) -> None:
+        if on_scene is not None:
+            on_scene(scene, number)
+        if at_once == 1:
+            hook = (lambda f: progress(number, f)) if progress is not None else None
+            deliver(*render(scene, options, number, hook))
+            return
+        pending.append((number, pool.submit(render, scene.copy(), one, number)))
+        if len(pending) == at_once:
+            oldest()
+
+    with ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="rend3r-frame") as pool:
+        try:
+            planned.replay(on_nf)
+            while pending:
+                oldest()
+        finally:  # after an error or an interrupt, frames not started are dropped
+            for _, future in pending:
+                future.cancel()
+    result.stats.instructions, result.stats.halt = planned.execution.instructions, planned.execution.halt
+    result.stats.at_once, result.stats.seconds = at_once, perf_counter() - start
     return result

@@ -69,6 +69,12 @@ class ObjectTable:
             self.index, self.values = merged, values
         return row_of
 
+    def copy(self) -> ObjectTable:
+        """A copy that later writes to this table leave as it is."""
+        other = ObjectTable()
+        other.index, other.values = self.index.copy(), self.values.copy()
+        return other
+
     def row(self, index: int) -> dict[int, int]:
         """The non-zero property words of ``index`` (KeyError if it was never written)."""
         at = int(np.searchsorted(self.index, index))
@@ -90,6 +96,11 @@ class Scene:
     lights: dict[int, dict[int, int]] = field(default_factory=dict)
     objects: ObjectTable = field(default_factory=ObjectTable)
     triangles: ObjectTable = field(default_factory=ObjectTable)
+
+    def copy(self) -> Scene:
+        """A copy that later writes to this scene leave as it is."""
+        return Scene(dict(self.camera), {k: dict(v) for k, v in self.lights.items()}, self.objects.copy(),
+                     self.triangles.copy())
 
     def clear(self) -> None:
         self.camera.clear()

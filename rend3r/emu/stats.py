@@ -59,6 +59,8 @@ class RunStats:
     frames: list[FrameStats] = field(default_factory=list)
     instructions: int = 0
     halt: str = ""
+    at_once: int = 1  # frames rendered side by side (then the run takes less than their sum)
+    seconds: float = 0.0  # the run's wall time
 
     def total(self, name: str) -> float:
         return sum(getattr(f, name) for f in self.frames)
@@ -78,8 +80,10 @@ class RunStats:
                 f"{f.device_cycles} cycles = {f.device_seconds:.3f} s at {CLOCK_HZ / 1e6:.0f} MHz"
             )
         if len(self.frames) > 1:
+            side = (f" ({self.at_once} frames at a time; the run took {self.seconds:.3f} s, its outputs included)"
+                    if self.at_once > 1 else "")
             lines.append(
-                f"total: {self.total('seconds'):.3f} s for {len(self.frames)} frames; device estimate "
+                f"total: {self.total('seconds'):.3f} s for {len(self.frames)} frames{side}; device estimate "
                 f"{self.total('device_seconds'):.3f} s"
             )
         return "\n".join(lines)

@@ -18,7 +18,8 @@ ANIMATION = load_program(Path(__file__).parents[2] / "programs" / "animation.asm
 #: A red triangle that moves right frame by frame in front of a green one.
 _SLIDE = assemble_source("\n".join([
     "nr", "cam rrot, 1", "cam hfov, 0.25", "cam vfov, 0.25",
-    "tr 1, x1, y1, -1, -3", "tr 1, z1, x2, -6, 4", "tr 1, y2, z2, -2, -6", "tr 1, x3, y3, 1, 3", "tr 1, z3, col, -6, 0x07E0",
+    "tr 1, x1, y1, -1, -3", "tr 1, z1, x2, -6, 4", "tr 1, y2, z2, -2, -6", "tr 1, x3, y3, 1, 3",
+    "tr 1, z3, col, -6, 0x07E0",
     "tr 0, y1, z1, -1, -4", "tr 0, y2, z2, -1, -4", "tr 0, y3, z3, 1.5, -4", "tr 0, col, col, 0xF800, 0xF800",
     *(f"tr 0, x1, x2, {-2 + k / 4}, {1 + k / 4}\ntr 0, x3, x3, {-0.5 + k / 4}, {-0.5 + k / 4}\nnf" for k in range(10)),
     "er"]))

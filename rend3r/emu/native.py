@@ -87,7 +87,7 @@ class Band(Structure):
 
 
 class Pairs(Structure):
-    """SE/SD pairs for pair_top, pair_marks and pair_apply (csrc/kernels.c Pairs)."""
+    """SE/SD pairs for pair_marks and pair_apply (csrc/kernels.c Pairs)."""
 
     _fields_ = [("words", c_void_p), ("n_words", c_int64), ("at", c_void_p), ("n", c_int64), ("fields", c_void_p),
                 ("tables", c_void_p), ("entry", c_int32), ("wanted", c_void_p), ("null", c_void_p)]
@@ -150,8 +150,7 @@ _PLAIN = {
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
     "stream_scan": (None, [c_void_p, c_int64, c_int64, c_int32, c_int32, c_void_p, c_void_p, c_void_p, c_void_p,
                            c_void_p, c_void_p]),
-    "pair_top": (c_int64, [POINTER(Pairs)]),
-    "pair_marks": (None, [POINTER(Pairs), c_void_p]),
+    "pair_marks": (c_int64, [POINTER(Pairs), c_void_p]),
     "pair_apply": (None, [POINTER(Pairs), c_void_p, c_void_p]),
 }
 

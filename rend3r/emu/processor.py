@@ -29,7 +29,7 @@ from ..isa import Table, ValueType, by_index
 from ..isa.extensions import TS_CODES, decode_table_select, table_select_word
 from ..isa.tables import (
     DATA, FUNC, LIGHT_INDEX, OPCODE, PROP, PROP_LIMIT, SD_DATA, SD_DATA2, SE_INDEX_HI, SE_INDEX_LO, SE_PROP2,
-    Field, Func, Opcode,
+    SHAPE_INDEX_LIMIT, Field, Func, Opcode,
 )
 from . import native
 from .options import EmuOptions
@@ -222,20 +222,18 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
                  table: ObjectTable) -> None:
     """Apply the SE/SD pairs at ``at`` (each writes prop then prop2; a write to a null
     property stores nothing) that ``wanted`` takes to ``table``, in compiled passes over
-    their words (csrc/kernels.c): the largest index, the indices written, the writes."""
+    their words (csrc/kernels.c): the indices written, then the writes."""
     if not wanted.any():
         return
     pairs = native.Pairs(words.ctypes.data, len(words), at.ctypes.data, len(at), _PAIR_FIELDS.ctypes.data,
                          None if tables is None else tables.ctypes.data, entry, wanted.ctypes.data,
                          _SE_NULL.ctypes.data)
-    lib = native.library()
-    top = lib.pair_top(byref(pairs))
+    lib, mark = native.library(), np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
+    top = lib.pair_marks(byref(pairs), mark.ctypes.data)
     if top < 0:
         raise Rend3rError(f"{_where(int(at[-1 - top]))}: an SE word without its SD")
     if top:
-        mark = table.marks(top)
-        lib.pair_marks(byref(pairs), mark.ctypes.data)
-        row_of = table.grow(mark)
+        row_of = table.grow(mark, top)
         lib.pair_apply(byref(pairs), row_of.ctypes.data, native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))
 
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..isa import Table, lookup
-from ..isa.tables import LIGHT_INDEX_LIMIT, PROP_LIMIT
+from ..isa.tables import LIGHT_INDEX_LIMIT, PROP_LIMIT, SHAPE_INDEX_LIMIT
 
 
 def prop_index(table: Table, name: str) -> int:
@@ -48,20 +48,17 @@ class ObjectTable:
     def __len__(self) -> int:
         return len(self.index)
 
-    def marks(self, top: int) -> np.ndarray:
-        """Zero marks (uint8) for the indices below ``top`` and those of the table, for
-        :meth:`grow`."""
-        return np.zeros(max(top, int(self.index[-1]) + 1 if len(self.index) else 0), np.uint8)
-
-    def grow(self, mark: np.ndarray) -> np.ndarray:
-        """Rows for the indices written (``mark`` from :meth:`marks`, 1 at each): a zero row
-        for each new index (a dense map over the index range: no sort). Returns the row of
-        every index below ``len(mark)`` that has one (int32; the others are undefined)."""
-        if mark.dtype != np.uint8 or mark.ndim != 1 or (len(self.index) and len(mark) <= self.index[-1]):
-            raise ValueError("grow: the marks must be bytes covering the table's indices")
+    def grow(self, mark: np.ndarray, top: int) -> np.ndarray:
+        """Rows for the indices written: ``mark`` (uint8, one per index a shape can have,
+        SHAPE_INDEX_LIMIT) is 1 at each, all below ``top``. Adds a zero row for each new
+        index (a dense map over the index range: no sort) and returns the row of every
+        index below ``top`` that has one (int32; the others are undefined)."""
+        if mark.shape != (SHAPE_INDEX_LIMIT,) or mark.dtype != np.uint8:
+            raise ValueError(f"grow: the marks must be {SHAPE_INDEX_LIMIT} bytes")
+        top = max(top, int(self.index[-1]) + 1 if len(self.index) else 0)
         mark[self.index] = 1
-        merged = np.flatnonzero(mark)
-        row_of = np.empty(len(mark), np.int32)
+        merged = np.flatnonzero(mark[:top])
+        row_of = np.empty(top, np.int32)
         row_of[merged] = np.arange(len(merged), dtype=np.int32)
         if len(merged) > len(self.index):
             values = np.zeros((len(merged), PROP_LIMIT), dtype=np.uint16)

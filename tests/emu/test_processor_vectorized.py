@@ -19,7 +19,7 @@ from rend3r.isa import (
     CameraSet, FrameOp, Func, LightSet, ShapeSet, Table, TrailingSE, Unknown, ValueType, by_index, decode_word, encode,
 )
 from rend3r.isa.extensions import decode_table_select, table_select_word
-from rend3r.isa.tables import OPCODE, UNUSED_OPCODES, Opcode
+from rend3r.isa.tables import OPCODE, SHAPE_INDEX_LIMIT, UNUSED_OPCODES, Opcode
 
 Objects = dict[int, tuple[int, ...]]  # index -> the 32 property words (0 where unwritten)
 State = tuple[dict[int, int], dict[int, dict[int, int]], Objects, Objects]
@@ -278,20 +278,19 @@ def test_last_write_wins_across_many_words():
 
 def test_object_table_grow_and_row():
     t = ObjectTable()
-    mark = t.marks(6)
+    mark = np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
     mark[[5, 2]] = 1
-    row_of = t.grow(mark)
+    row_of = t.grow(mark, 6)
     t.values[row_of[5], 1], t.values[row_of[2], 3] = 30, 20
     assert t.index.tolist() == [2, 5] and t.row(5) == {1: 30} and t.row(2) == {3: 20}
-    mark = t.marks(4)
-    assert len(mark) == 6  # the table's indices are covered
+    mark = np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
     mark[3] = 1
-    row_of = t.grow(mark)  # a new index below the others: rows move, values with them
+    row_of = t.grow(mark, 4)  # a new index below the others: rows move, values with them
     t.values[row_of[5], 2] = 7
     assert t.index.tolist() == [2, 3, 5] and t.row(3) == {} and t.row(5) == {1: 30, 2: 7} and len(t) == 3
     with pytest.raises(KeyError):
         t.row(4)
     with pytest.raises(ValueError, match="marks"):
-        t.grow(np.zeros(5, np.uint8))
+        t.grow(np.zeros(10, np.uint8), 1)
     t.clear()
     assert len(t) == 0

@@ -396,72 +396,60 @@ static inline int32_t pair_table(const uint8_t *tables, int32_t entry, int64_t k
     return tables != NULL && tables[k] ? tables[k] : entry;
 }
 
-static inline int pair_taken(const Pairs *p, const PairFields *f, int64_t k, uint32_t se, int32_t *table)
+/* Which of pair k's two writes store a word (bit 0: prop, bit 1: prop2; 0 when the pair
+ * is not taken), and its table code. */
+static inline unsigned pair_stores(const uint8_t *wanted, const uint8_t *null, const uint8_t *tables, int32_t entry,
+                                   const PairFields *f, int64_t k, uint32_t se, int32_t *table)
 {
-    *table = pair_table(p->tables, p->entry, k);
-    const uint8_t *nulls = p->null + 32 * (*table - 1);
-    return p->wanted[*table] && !(nulls[FIELD(*f, se, 2)] && nulls[FIELD(*f, se, 3)]);
+    *table = pair_table(tables, entry, k);
+    const uint8_t *nulls = null + 32 * (*table - 1);
+    return wanted[*table] ? (unsigned)!nulls[FIELD(*f, se, 2)] | (unsigned)!nulls[FIELD(*f, se, 3)] << 1 : 0u;
 }
 
-/* The largest index + 1 of the pairs taken that store a word (0 for none), or -1 - k for
- * the first pair k whose SD lies outside the words (then nothing may be written). */
-int64_t pair_top(const Pairs *p)
+/* Marks the index of every pair taken that stores a word: mark[index] = 1 (mark holds
+ * 2^19 bytes, every index). Returns the largest index marked + 1 (0 for none), or -1 - k
+ * for the first pair k whose SD lies outside the words (then nothing may be written). */
+int64_t pair_marks(const Pairs *p, uint8_t *mark)
 {
+    const uint32_t *words = p->words;
+    const int64_t *at = p->at;
+    const uint8_t *tables = p->tables, *wanted = p->wanted, *null = p->null;
+    int64_t n = p->n, n_words = p->n_words, top = 0;
+    int32_t entry = p->entry, table;
     PairFields f = pair_fields(p);
-    int64_t top = 0;
-    int32_t table;
-    for (int64_t k = 0; k < p->n; k++) {
-        int64_t at = p->at[k];
-        if (at < 0 || at + 1 >= p->n_words)
+    for (int64_t k = 0; k < n; k++) {
+        if (at[k] < 0 || at[k] + 1 >= n_words)
             return -1 - k;
-        uint32_t se = p->words[at];
-        if (!pair_taken(p, &f, k, se, &table))
+        uint32_t se = words[at[k]];
+        if (!pair_stores(wanted, null, tables, entry, &f, k, se, &table))
             continue;
         int64_t index = ((int64_t)FIELD(f, se, 0) << f.hi_shift) | FIELD(f, se, 1);
+        mark[index] = 1;
         top = index >= top ? index + 1 : top;
     }
     return top;
 }
 
-/* Marks the index of every pair taken that stores a word: mark[index] = 1 (mark holds
- * pair_top()'s count at least; pair_top checked the addresses). */
-void pair_marks(const Pairs *p, uint8_t *mark)
-{
-    const uint32_t *words = p->words;
-    const int64_t *at = p->at;
-    int64_t n = p->n;
-    PairFields f = pair_fields(p);
-    int32_t table;
-    for (int64_t k = 0; k < n; k++) {
-        uint32_t se = words[at[k]];
-        if (pair_taken(p, &f, k, se, &table))
-            mark[((int64_t)FIELD(f, se, 0) << f.hi_shift) | FIELD(f, se, 1)] = 1;
-    }
-}
-
 /* Writes the pairs taken, in order, to a table of 32 property words per row (the last
- * write to a word wins), row row_of[index]. pair_top checked the addresses. */
+ * write to a word wins), row row_of[index]. pair_marks checked the addresses. */
 void pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values)
 {
     const uint32_t *words = p->words;
     const int64_t *at = p->at;
     const uint8_t *tables = p->tables, *wanted = p->wanted, *null = p->null;
     int64_t n = p->n;
-    int32_t entry = p->entry;
+    int32_t entry = p->entry, table;
     PairFields f = pair_fields(p);
     for (int64_t k = 0; k < n; k++) {
-        int32_t table = pair_table(tables, entry, k);
-        if (!wanted[table])
-            continue;
         uint32_t se = words[at[k]], sd = words[at[k] + 1];
-        int64_t index = ((int64_t)FIELD(f, se, 0) << f.hi_shift) | FIELD(f, se, 1);
-        uint16_t *row = values + 32 * (int64_t)row_of[index];
-        const uint8_t *nulls = null + 32 * (table - 1);
-        uint32_t prop = FIELD(f, se, 2), prop2 = FIELD(f, se, 3);
-        if (!nulls[prop])
-            row[prop] = (uint16_t)FIELD(f, sd, 4);
-        if (!nulls[prop2])
-            row[prop2] = (uint16_t)FIELD(f, sd, 5);
+        unsigned stores = pair_stores(wanted, null, tables, entry, &f, k, se, &table);
+        if (!stores)
+            continue;
+        uint16_t *row = values + 32 * (int64_t)row_of[((int64_t)FIELD(f, se, 0) << f.hi_shift) | FIELD(f, se, 1)];
+        if (stores & 1u)
+            row[FIELD(f, se, 2)] = (uint16_t)FIELD(f, sd, 4);
+        if (stores & 2u)
+            row[FIELD(f, se, 3)] = (uint16_t)FIELD(f, sd, 5);
     }
 }
 #undef FIELD

@@ -64,13 +64,10 @@ def write_atomic(path: str | os.PathLike[str], data: bytes) -> None:
     check_writable(target)
     made = make_folders(target)
     tmp = directory / f".rend3r-{secrets.token_hex(6)}.tmp"  # short: any target name fits
-    try:
+    try:  # one block from the file's creation on: an interrupt right after os.open returns
+        # (before the next statement) still removes it; the random name is ours alone.
         # 0o666 filtered by the umask, as for an ordinary new file.
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
-    except OSError as exc:
-        remove_folders(made)
-        raise Rend3rError(f"cannot write {target}: {exc.strerror or exc}") from exc
-    try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()
@@ -78,7 +75,8 @@ def write_atomic(path: str | os.PathLike[str], data: bytes) -> None:
         _keep_mode(target, tmp)
         os.replace(tmp, target)
     except BaseException as exc:
-        tmp.unlink(missing_ok=True)
+        if not isinstance(exc, FileExistsError):  # os.open met a file of that name: not ours
+            tmp.unlink(missing_ok=True)
         remove_folders(made)
         if isinstance(exc, OSError):
             raise Rend3rError(f"cannot write {target}: {exc.strerror or exc}") from exc
@@ -209,11 +207,12 @@ class Outputs:
         if old is not None:
             old.unlink(missing_ok=True)
         stage = p.with_name(f".rend3r-{secrets.token_hex(6)}.part")  # short: any target name fits
+        self._staged[p] = stage  # before it exists: an interrupt at any point leaves it to abort()
         try:
             write_atomic(stage, data)
         except Rend3rError as exc:
+            del self._staged[p]
             raise Rend3rError(str(exc).replace(str(stage), str(p))) from None
-        self._staged[p] = stage
 
     def commit(self) -> None:
         """Move every staged file into place; if one cannot be, put back the ones already

@@ -8,7 +8,7 @@ import stat
 import pytest
 
 from rend3r.errors import Rend3rError
-from rend3r.fileio import make_output_folder, write_atomic
+from rend3r.fileio import Outputs, make_output_folder, write_atomic
 
 
 def test_writes_new_file_with_umask_mode(tmp_path):
@@ -107,3 +107,31 @@ def test_interrupted_write_leaves_nothing(tmp_path, monkeypatch):
         write_atomic(target, b"new")
     assert target.read_bytes() == b"previous"
     assert os.listdir(tmp_path) == ["out.mem"]
+
+
+def test_an_interrupt_as_the_temporary_file_is_opened_leaves_nothing(tmp_path, monkeypatch):
+    """Ctrl-C delivered just after os.open has created the file (before the next statement)."""
+    real_open = os.open
+
+    def open_then_interrupt(path, flags, mode=0o777):
+        os.close(real_open(path, flags, mode))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(os, "open", open_then_interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        write_atomic(tmp_path / "sub" / "out.mem", b"new")
+    assert os.listdir(tmp_path) == []
+
+
+def test_an_interrupt_as_an_output_is_staged_leaves_nothing(tmp_path, monkeypatch):
+    """Ctrl-C after the staged file is in place but before Outputs recorded it."""
+    real_replace = os.replace
+
+    def replace_then_interrupt(src, dst):
+        real_replace(src, dst)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(os, "replace", replace_then_interrupt)
+    with pytest.raises(KeyboardInterrupt), Outputs() as outputs:
+        outputs.write(tmp_path / "frame.png", b"png")
+    assert os.listdir(tmp_path) == []

@@ -52,10 +52,18 @@ def _renderer(options: EmuOptions):
     return render_frame
 
 
-#: Working memory of a frame in flight, per pixel, at most (every mode; the raytracer's band
-#: arrays take about 100 bytes), and what frames in flight may hold together by default.
+#: Working memory of a frame in flight, per pixel and per shape or triangle, at most (every
+#: mode: the raytracer's band arrays take about 85 bytes a pixel; the scene's copy, shape
+#: tables, tree and bounds about 480 bytes a shape), and what frames in flight may hold
+#: together by default.
 FRAME_BYTES_PER_PIXEL = 128
+FRAME_BYTES_PER_SHAPE = 512
 FLIGHT_BYTES = 512 << 20
+
+
+def frame_bytes(options: EmuOptions, scene: Scene) -> int:
+    """The most a frame of ``scene`` holds while it renders (FRAME_BYTES_PER_*)."""
+    return FRAME_BYTES_PER_PIXEL * options.pixels + FRAME_BYTES_PER_SHAPE * (len(scene.objects) + len(scene.triangles))
 
 
 def frames_at_once(options: EmuOptions, count: int, memory: int = FLIGHT_BYTES) -> int:
@@ -94,7 +102,7 @@ def run_program(
     at_once = frames_at_once(options, planned.execution.frames, memory)
     one = replace(options, jobs=1)
     previous: list[Frame] = []
-    pending: deque[tuple[int, Future]] = deque()
+    pending: deque[tuple[int, int, Future]] = deque()  # frame number, bytes, its render
 
     def deliver(frame: Frame, st: FrameStats) -> None:
         if options.mode == "raster" and not options.clear_frames and previous:
@@ -110,7 +118,7 @@ def run_program(
             on_frame(frame)
 
     def oldest() -> None:
-        number, future = pending.popleft()
+        number, _, future = pending.popleft()
         deliver(*future.result())
         if progress is not None:
             progress(number, 1.0)
@@ -122,9 +130,10 @@ def run_program(
             hook = (lambda f: progress(number, f)) if progress is not None else None
             deliver(*render(scene, options, number, hook))
             return
-        pending.append((number, pool.submit(render, scene.copy(), one, number)))
-        if len(pending) == at_once:
+        need = frame_bytes(options, scene)  # frames in flight (and this one) within memory
+        while pending and (len(pending) == at_once or sum(b for _, b, _ in pending) + need > memory):
             oldest()
+        pending.append((number, need, pool.submit(render, scene.copy(), one, number)))
 
     with ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="rend3r-frame") as pool:
         try:
@@ -132,7 +141,7 @@ def run_program(
             while pending:
                 oldest()
         finally:  # after an error or an interrupt, frames not started are dropped
-            for _, future in pending:
+            for _, _, future in pending:
                 future.cancel()
     result.stats.instructions, result.stats.halt = planned.execution.instructions, planned.execution.halt
     result.stats.at_once, result.stats.seconds = at_once, perf_counter() - start

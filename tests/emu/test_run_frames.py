@@ -11,7 +11,7 @@ import pytest
 from rend3r.asm.assembler import assemble_source
 from rend3r.emu.loader import load_program
 from rend3r.emu.options import EmuOptions
-from rend3r.emu.run import FRAME_BYTES_PER_PIXEL, frames_at_once, run_program
+from rend3r.emu.run import FRAME_BYTES_PER_PIXEL, FRAME_BYTES_PER_SHAPE, frames_at_once, run_program
 from rend3r.emu.scene import Scene
 
 ANIMATION = load_program(Path(__file__).parents[2] / "programs" / "animation.asm").words
@@ -64,6 +64,18 @@ def test_frames_at_once_needs_a_frame_per_thread_and_the_memory():
     assert frames_at_once(options, 100, memory=2 * frame) == 2
     assert frames_at_once(options, 100, memory=frame) == 1
     assert frames_at_once(replace(options, jobs=1), 100) == 1
+
+
+def test_frames_wait_for_memory_the_shapes_take():
+    """Memory for two frames' pixels but not their shapes as well: one frame at a time."""
+    options = EmuOptions(precision="fp32", width=32, height=24, jobs=2)
+    memory = 2 * FRAME_BYTES_PER_PIXEL * options.pixels + FRAME_BYTES_PER_SHAPE
+    assert frames_at_once(options, 6, memory) == 2
+    tight = run_program(ANIMATION, options, 6, memory=memory)
+    free = run_program(ANIMATION, replace(options, jobs=1), 6)
+    assert [f.number for f in tight.frames] == list(range(6))
+    for a, b in zip(tight.frames, free.frames, strict=True):
+        assert np.array_equal(a.rgb565, b.rgb565) and np.array_equal(a.provenance, b.provenance)
 
 
 def test_a_scene_copy_keeps_its_values_when_the_scene_changes():

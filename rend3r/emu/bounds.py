@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import native, threads
+from .native import address
 
 #: Shapes a thread takes at least.
 SHAPE_CHUNK = 1 << 10
@@ -32,8 +33,8 @@ def primary(table: np.ndarray, ok: np.ndarray, apex: np.ndarray, dmin: float, dm
     radius, floor, pc = np.empty(n), np.empty(n), np.empty((n, native.PC_COLUMNS))
     lib = native.library()
     threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: lib.primary_shapes(
-        table[a:].ctypes.data, flags[a:].ctypes.data, b - a, apex.ctypes.data, dmin, dmax, u, tiny, overflow,
-        radius[a:].ctypes.data, floor[a:].ctypes.data, pc[a:].ctypes.data))
+        address(table[a:]), address(flags[a:]), b - a, address(apex), dmin, dmax, u, tiny, overflow,
+        address(radius[a:]), address(floor[a:]), address(pc[a:])))
     return radius, floor, pc
 
 
@@ -58,9 +59,9 @@ def shadow(table: np.ndarray, ok: np.ndarray, lo: np.ndarray, hi: np.ndarray, dm
     radius, behind = np.empty(n), None if unit is None else np.empty((n, 3))
     lib = native.library()
     threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: lib.shadow_shapes(
-        table[a:].ctypes.data, flags[a:].ctypes.data, b - a, mid.ctypes.data, half, magnitude, dmin, chord, u, tiny,
-        overflow, None if unit is None else unit.ctypes.data, length, radius[a:].ctypes.data,
-        None if behind is None else behind[a:].ctypes.data))
+        address(table[a:]), address(flags[a:]), b - a, address(mid), half, magnitude, dmin, chord, u, tiny,
+        overflow, None if unit is None else address(unit), length, address(radius[a:]),
+        None if behind is None else address(behind[a:])))
     return radius, behind
 
 

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import Rend3rError
 from . import native
+from .native import address
 
 
 @dataclass(frozen=True)
@@ -50,9 +51,9 @@ class Tree:
         frame = np.zeros(6)
         frame[: 3 if apex is not None else 6] = np.ravel(apex if apex is not None else axes)
         bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame)
-        native.library().bvh_refit(bounds.struct(), bnd.ctypes.data, radius.ctypes.data,
-                                   None if floor is None else floor.ctypes.data, kind, frame.ctypes.data,
-                                   bounds.box.ctypes.data)
+        native.library().bvh_refit(bounds.struct(), address(bnd), address(radius),
+                                   None if floor is None else address(floor), kind, address(frame),
+                                   address(bounds.box))
         return bounds
 
 
@@ -67,8 +68,8 @@ class Bounds:
     def struct(self) -> native.Bvh:
         """The kernels' view (the arrays must outlive it)."""
         t = self.tree
-        return native.Bvh(t.node.ctypes.data, t.items.ctypes.data, self.box.ctypes.data, (*self.frame,), t.nodes,
-                          t.always.ctypes.data, len(t.always))
+        return native.Bvh(address(t.node), address(t.items), address(self.box), (*self.frame,), t.nodes,
+                          address(t.always), len(t.always))
 
 
 def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
@@ -79,7 +80,7 @@ def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
     inside = np.asarray(bounded, bool) & np.isfinite(bnd[:, :3]).all(axis=1)
     items = np.flatnonzero(inside).astype(np.int32)
     node = np.empty((max(1, 2 * len(items)), 2), np.int32)
-    count = native.library().bvh_build(bnd.ctypes.data, items.ctypes.data, len(items), node.ctypes.data)
+    count = native.library().bvh_build(address(bnd), address(items), len(items), address(node))
     if count < 0:
         raise Rend3rError(f"not enough memory to build the shape hierarchy of {len(items):,} shapes")
     return Tree(np.ascontiguousarray(node[:count]), items, np.flatnonzero(~inside).astype(np.int32))

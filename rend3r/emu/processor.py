@@ -32,6 +32,7 @@ from ..isa.tables import (
     SHAPE_INDEX_LIMIT, Field, Func, Opcode,
 )
 from . import native
+from .native import address
 from .options import EmuOptions
 from .scene import ObjectTable, Scene
 
@@ -126,8 +127,8 @@ class _Stream:
         self.prog, self.start = prog, start
         room = max(0, len(prog.words) - start)
         lists, count = [np.empty(room, np.int64) for _ in range(4)], np.zeros(4, np.int64)
-        native.library().stream_scan(prog.words.ctypes.data, len(prog.words), start, OPCODE.lo, OPCODE.width,
-                                     _KIND.ctypes.data, *(a.ctypes.data for a in lists), count.ctypes.data)
+        native.library().stream_scan(address(prog.words), len(prog.words), start, OPCODE.lo, OPCODE.width,
+                                     address(_KIND), *(address(a) for a in lists), address(count))
         # Addresses of the instructions per kind (_KIND), in order; an SE's pair is one instruction.
         self.by_kind = [a[:c] for a, c in zip(lists, count.tolist())]
         self._find_stop(self.by_kind[_CONTROL])
@@ -225,16 +226,16 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
     their words (csrc/kernels.c): the indices written, then the writes."""
     if not wanted.any():
         return
-    pairs = native.Pairs(words.ctypes.data, len(words), at.ctypes.data, len(at), _PAIR_FIELDS.ctypes.data,
-                         None if tables is None else tables.ctypes.data, entry, wanted.ctypes.data,
-                         _SE_NULL.ctypes.data)
+    pairs = native.Pairs(address(words), len(words), address(at), len(at), address(_PAIR_FIELDS),
+                         None if tables is None else address(tables), entry, address(wanted),
+                         address(_SE_NULL))
     lib, mark = native.library(), np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
-    top = lib.pair_marks(byref(pairs), mark.ctypes.data)
+    top = lib.pair_marks(byref(pairs), address(mark))
     if top < 0:
         raise Rend3rError(f"{_where(int(at[-1 - top]))}: an SE word without its SD")
     if top:
         row_of = table.grow(mark, top)
-        lib.pair_apply(byref(pairs), row_of.ctypes.data, native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))
+        lib.pair_apply(byref(pairs), address(row_of), native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))
 
 
 @dataclass(frozen=True)

@@ -33,6 +33,7 @@ import numpy as np
 from ..isa import Table, lookup
 from ..isa.tables import PROP_LIMIT, SHAPE_TYPE_CODES
 from . import bounds, bvh, native, threads
+from .native import address
 from .arith import Arith
 from .camera import camera_rays
 from .frame import Frame
@@ -161,8 +162,8 @@ def _shape_tables(scene: Scene, ar: Arith, fmt) -> tuple[np.ndarray, ...]:
     bounded = np.empty(rows, np.uint8)
     out = np.empty(rows, np.int32)
     n = native.kernel("shape_tables", ar)(
-        native.ptr(values, np.uint16, (rows, PROP_LIMIT)), index.ctypes.data, rows, _SHAPE_PROPS.ctypes.data,
-        _KINDS.ctypes.data, sf.ctypes.data, si.ctypes.data, bnd.ctypes.data, bounded.ctypes.data, out.ctypes.data, fmt)
+        native.ptr(values, np.uint16, (rows, PROP_LIMIT)), address(index), rows, address(_SHAPE_PROPS),
+        address(_KINDS), address(sf), address(si), address(bnd), address(bounded), address(out), fmt)
     return sf[:n], si[:n], bnd[:n], bounded[:n].astype(bool), out[:n]
 
 
@@ -187,9 +188,9 @@ def trace_pixel(fr: _Frame, options: EmuOptions, x: int, y: int) -> PixelTrace:
     shape_out = np.zeros((n, native.TRACE_SHAPE_VALUES))
     light_out = np.zeros((nl, native.TRACE_LIGHT_VALUES))
     nearest = np.zeros(1, np.int64)
-    colour = fr.kernel("trace_pixel")(byref(band), int(options.intensity_fixed), int(n > 1), fr.light_rows.ctypes.data,
-                                      scales.ctypes.data, nl, x, y, shape_out.ctypes.data, light_out.ctypes.data,
-                                      nearest.ctypes.data)
+    colour = fr.kernel("trace_pixel")(byref(band), int(options.intensity_fixed), int(n > 1), address(fr.light_rows),
+                                      address(scales), nl, x, y, address(shape_out), address(light_out),
+                                      address(nearest))
     return PixelTrace(shape_out, light_out, int(nearest[0]), None if colour < 0 else int(colour))
 
 
@@ -212,7 +213,7 @@ def _run(jobs: int, n: int, fn: Callable[..., object], block: object, last: np.n
     copies = isinstance(last, np.ndarray)
     outs = _own_lines(last, len(chunks)) if copies else None
     ref = byref(block)
-    threads.each(jobs, [lambda k=k, a=a, b=b: fn(ref, a, b, outs[k].ctypes.data if copies else last)
+    threads.each(jobs, [lambda k=k, a=a, b=b: fn(ref, a, b, address(outs[k]) if copies else last)
                         for k, (a, b) in enumerate(chunks)])
     return outs
 
@@ -230,7 +231,7 @@ def _own_lines(last: np.ndarray, count: int) -> np.ndarray:
     if len(last) > _ROW:
         raise ValueError(f"a report row holds at most {_ROW} values")
     buf = np.empty((count + 2) * _ROW + _LINE // 8)
-    start = (-buf.ctypes.data % _LINE) // 8 + _ROW  # aligned, one padding row before
+    start = (-address(buf) % _LINE) // 8 + _ROW  # aligned, one padding row before
     rows = buf[start:start + count * _ROW].reshape(count, _ROW)[:, :len(last)]
     rows[:] = last
     return rows
@@ -278,14 +279,14 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
     extent = _extent(fr, row0, row1)
     if extent is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
         a["dirs"] = np.empty((n_pix, 4), dtype)
-        band.dirs = a["dirs"].ctypes.data
+        band.dirs = address(a["dirs"])
         parts = _run(fr.jobs, n_pix, fr.kernel("directions"), band, np.array([0.0, np.inf, 0.0]))
         extent = (float(parts[:, 1].min()), float(parts[:, 2].max())) if parts[:, 0].sum() else (0.0, 0.0)
     primary, floor, pc = _primary_tree(fr, *extent)
-    band.pc, band.floor, band.tree = pc.ctypes.data, floor.ctypes.data, primary.struct()
+    band.pc, band.floor, band.tree = address(pc), address(floor), primary.struct()
     for name in ("slot", "sqd", "pt", "nm", "bad", "nan_px", "acc"):
-        setattr(band, name, a[name].ctypes.data)
-    band.index, band.background = fr.index.ctypes.data, options.background
+        setattr(band, name, address(a[name]))
+    band.index, band.background = address(fr.index), options.background
     band.rgb, band.depth = native.ptr(rgb, np.uint16, (n_pix,)), native.ptr(depth, np.float32, (n_pix,))
     band.prov = native.ptr(prov, np.int32, (n_pix,))
     c = _report(_run(fr.jobs, row1 - row0, fr.kernel("nearest"), band, _OUT, max(1, MIN_CHUNK // w)))
@@ -338,9 +339,9 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
     lp.first, lp.last = int(k == 0), int(k == len(fr.lights) - 1)
     if shadows:  # lp points into the arrays of sb: they live until the pass is done
         sb = _shadow_bounds(fr, lp, light, hits, n_pix)
-        lp.tree, lp.radius, lp.along = sb.bounds.struct(), sb.radius.ctypes.data, sb.along.ctypes.data
+        lp.tree, lp.radius, lp.along = sb.bounds.struct(), address(sb.radius), address(sb.along)
         if sb.behind is not None:
-            lp.behind, lp.keys = sb.behind.ctypes.data, sb.keys.ctypes.data
+            lp.behind, lp.keys = address(sb.behind), address(sb.keys)
             lp.l_len, lp.l_hat[:] = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     c = _report(_run(fr.jobs, n_pix, fr.kernel("light_pass"), lp, _OUT))
     st.shadow_rays += int(c[native.OUT_SHADOW_RAYS])
@@ -393,12 +394,12 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
     radius, behind = bounds.shadow(fr.bnd, fr.bounded, lo, hi, length, *limits, unit=unit, length=length,
                                    jobs=fr.jobs)
     along = np.empty((n, 4), fr.dtype)
-    fr.kernel("shadow_directions")(byref(fr.shapes), light.ctypes.data, along.ctypes.data)
+    fr.kernel("shadow_directions")(byref(fr.shapes), address(light), address(along))
     lib, keys = native.library(), np.empty((n, 3))
-    lib.behind_keys(behind.ctypes.data, radius.ctypes.data, n, length, keys.ctypes.data)
+    lib.behind_keys(address(behind), address(radius), n, length, address(keys))
     flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit))
     node_keys = np.empty((fr.tree.nodes, 3))
-    lib.bvh_keys(flat.struct(), keys.ctypes.data, node_keys.ctypes.data)
+    lib.bvh_keys(flat.struct(), address(keys), address(node_keys))
     return _ShadowBounds(radius, flat, along, behind, node_keys)
 
 

@@ -462,9 +462,29 @@ void round16_array(const float *in, float *out, int64_t n, int32_t ftz)
         out[i] = round16(in[i], ftz);
 }
 
-/* The library is loaded with ctypes; the module object only makes it importable. */
+/* The address of an object's C-contiguous buffer (a numpy array's data), for the ctypes
+ * calls: what ndarray.ctypes.data gives without building a ctypes object, in a tenth of
+ * its 1.6 us (a frame passes over a hundred addresses). A buffer that is not C-contiguous
+ * is refused (BufferError). */
+static PyObject *address(PyObject *self, PyObject *obj)
+{
+    (void)self;
+    Py_buffer view;
+    if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS) < 0)
+        return NULL;
+    PyObject *at = PyLong_FromVoidPtr(view.buf);
+    PyBuffer_Release(&view);
+    return at;
+}
+
+static PyMethodDef methods[] = {
+    {"address", address, METH_O, "The address of a C-contiguous buffer's first byte."},
+    {NULL, NULL, 0, NULL},
+};
+
+/* The kernels are called through ctypes; the module itself only offers address(). */
 static struct PyModuleDef module = {
-    PyModuleDef_HEAD_INIT, "_kernels", "rend3r's compiled raytracer kernels", -1, NULL, NULL, NULL, NULL, NULL,
+    PyModuleDef_HEAD_INIT, "_kernels", "rend3r's compiled raytracer kernels", -1, methods, NULL, NULL, NULL, NULL,
 };
 
 PyMODINIT_FUNC PyInit__kernels(void) { return PyModule_Create(&module); }

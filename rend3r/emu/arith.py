@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Literal
 
 import numpy as np
@@ -87,7 +87,7 @@ class Arith:
         """The precision of a stage (None: outside the stages, the base)."""
         return dict(self.stages).get(stage or "", self.precision)
 
-    @property
+    @cached_property
     def native(self) -> bool:
         """fp16, fp32 or fp64 as the device's IP rounds them: kernels of their own, float32
         or float64 arrays (fp16 judging tininess before rounding runs as any other format,
@@ -99,7 +99,7 @@ class Arith:
         """The format of the stage the current operation is made in."""
         return self.stage_formats.get(current_stage(3) or "", self.format)
 
-    @property
+    @cached_property
     def dtype(self) -> type[np.floating]:
         return np.float32 if self.native and self.precision != "fp64" else np.float64
 
@@ -299,11 +299,13 @@ def _round16_f32(a: np.ndarray, ftz: bool) -> np.ndarray:
     return r.view(np.float32)
 
 
+@lru_cache(maxsize=64)
 def make_arith(precision: Precision = "fp16", subnormals: Literal["ftz", "ieee"] = "ftz",
                tininess: Tininess = "after", stages: tuple[tuple[str, Precision], ...] = ()) -> Arith:
     """The arithmetic for a ``--precision`` / ``--subnormals`` pair and a per-stage map
     (``--stage-precision``; stages in the base precision are dropped, so a uniform map is
-    the plain working precision). ValueError for a bad name."""
+    the plain working precision). ValueError for a bad name. The same arguments give the
+    same (immutable) object, so what it caches outlives a frame."""
     base = precision_name(precision)
     differing = tuple((s, p) for s, p in ((s, precision_name(p)) for s, p in stages) if p != base)
     return Arith(base, subnormals == "ftz", tininess, differing)

@@ -153,9 +153,9 @@ class _Stream:
         self.stop, self.kind = min(ends, default=(n, "end"))
         self.nfs = nf[nf < self.stop]
 
-    def executed_before(self, address: int) -> int:
-        """Instructions of this stream that start before ``address``."""
-        return sum(int(np.searchsorted(a, address)) for a in self.by_kind)
+    def executed_before(self, at: int) -> int:
+        """Instructions of this stream that start before address ``at``."""
+        return sum(int(np.searchsorted(a, at)) for a in self.by_kind)
 
     def error(self) -> Rend3rError:
         """The error at ``stop`` (kind "error")."""

@@ -39,7 +39,8 @@ def _run(options: EmuOptions, frames: int = 10):
     EmuOptions(precision="fp16", width=64, height=48),
     EmuOptions(precision="fp32", subnormals="ieee", width=33, height=17, display="rgb444"),
     EmuOptions(mode="raster", clear_frames=False, width=40, height=30),  # each frame keeps the last one's pixels
-], ids=["fp16", "fp32-rgb444", "raster-keeps-pixels"])
+    EmuOptions(mode="hybrid", precision="fp32", width=24, height=18),
+], ids=["fp16", "fp32-rgb444", "raster-keeps-pixels", "hybrid"])
 def test_side_by_side_frames_equal_one_at_a_time(options):
     one, seen_one, _ = _run(replace(options, jobs=1))
     many, seen_many, progress = _run(replace(options, jobs=3))

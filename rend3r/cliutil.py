@@ -97,9 +97,10 @@ STAGE_PRECISION = click.option(
          "(docs/precision.md).")
 
 
-#: ``--jobs N``: threads rendering each frame (0, the default: every core this process may use).
+#: ``--jobs N``: rendering threads (0, the default: every core this process may use).
 JOBS = click.option("--jobs", type=click.IntRange(0, 256), default=0, show_default=True, metavar="N",
-                    help="Threads rendering each frame; 0 uses every core. The image does not depend on it.")
+                    help="Rendering threads, 0 for every core: one frame each when a run has a frame "
+                         "for every thread, else each frame split between them. The images do not depend on it.")
 
 
 _BYTES = re.compile(r"\s*([0-9]{1,12}(?:\.[0-9]{1,6})?)\s*([KMGT]?)(?:i?B)?\s*", re.ASCII | re.IGNORECASE)

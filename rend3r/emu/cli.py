@@ -84,8 +84,8 @@ def emulate_command(program, output, frames, mode, precision, stage_precision, s
     import numpy as np
 
     from ..cliutil import default_memory
-    from .budget import ENCODE, FRAME, estimate_memory
-    from .image import (ANIMATION_KINDS, DATA_KINDS, FRAME_KINDS, OrderedWriter, check_output, frame_path, is_pattern,
+    from .budget import estimate_memory
+    from .image import (ANIMATION_KINDS, DATA_KINDS, FRAME_KINDS, check_output, frame_path, is_pattern,
                         save_animation, save_depth, save_png, save_provenance)
     from .loader import load_program
     from .options import EmuOptions
@@ -93,7 +93,6 @@ def emulate_command(program, output, frames, mode, precision, stage_precision, s
     from .processor import execute
     from .quirks import apply_quirks, quirk_names
     from .run import FRAME_BYTES_PER_PIXEL, run_program
-    from .threads import available_cores
     from .trace import parse_pixel
 
     if gif_path and apng_path:
@@ -147,26 +146,13 @@ def emulate_command(program, output, frames, mode, precision, stage_precision, s
             outputs.reserve(path)
     rgb_frames = []
 
-    def encoded(frame) -> list:
-        files: list = []
-        keep = lambda path, data: files.append((path, data))  # noqa: E731
-        if output:
-            save_png(frame.rgb565, frame_path(output, frame.number), sink=keep)
-        if depth_path:
-            save_depth(frame.depth, frame_path(depth_path, frame.number), sink=keep)
-        if prov_path:
-            save_provenance(frame.provenance, frame_path(prov_path, frame.number), sink=keep)
-        return files
-
-    # What the budget leaves goes half to frames rendering side by side, half to frames'
-    # files encoded on threads (as many as cores).
-    spare = (budget - need) // 2
-    writer = OrderedWriter(encoded, outputs.write,
-                           min(options.jobs or available_cores(), 1 + spare // ((FRAME + ENCODE) * options.pixels)))
-
     def on_frame(frame) -> None:
-        if output or depth_path or prov_path:
-            writer.add(frame)
+        if output:
+            save_png(frame.rgb565, frame_path(output, frame.number), sink=outputs.write)
+        if depth_path:
+            save_depth(frame.depth, frame_path(depth_path, frame.number), sink=outputs.write)
+        if prov_path:
+            save_provenance(frame.provenance, frame_path(prov_path, frame.number), sink=outputs.write)
         if animate:
             rgb_frames.append(frame.rgb565)
 
@@ -190,12 +176,11 @@ def emulate_command(program, output, frames, mode, precision, stage_precision, s
 
     # Extreme values (inf, NaN, 65504, huge cameras) are the renderer's documented input: their
     # rays count as misses and are reported below, so numpy's own warnings are not shown.
-    with outputs, writer, np.errstate(all="ignore"), warnings.catch_warnings():
+    with outputs, np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         with Progress(count * 1000, "rendering", quiet=quiet) as bar:
             result = run_program(loaded.words, options, frames, on_frame, progress, keep_frames=False,
-                                 on_scene=on_scene, memory=spare + FRAME_BYTES_PER_PIXEL * options.pixels)
-        writer.finish()
+                                 on_scene=on_scene, memory=budget - need + FRAME_BYTES_PER_PIXEL * options.pixels)
         if trace_path:
             outputs.write(trace_path, trace_buf.getvalue().encode())
         if animate:

@@ -7,10 +7,8 @@ import io
 import os
 import re
 import string
-from collections import deque
-from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
-from typing import Callable, Generic, Sequence, TypeVar
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -213,39 +211,3 @@ def is_pattern(path: str) -> bool:
         return check_pattern(path)
     except ValueError:
         return False
-
-
-Item = TypeVar("Item")
-Encoded = list[tuple[Path, bytes]]
-
-
-class OrderedWriter(Generic[Item]):
-    """Encodes items (a run's frames) on ``workers`` threads, as Pillow's encoders release
-    the GIL, and hands each item's files to ``sink`` in the order the items came; at most
-    ``workers`` items wait. Use as a context manager: leaving it on an error drops what
-    was not written yet."""
-
-    def __init__(self, encode: Callable[[Item], Encoded], sink: Sink, workers: int) -> None:
-        self._encode, self._sink, self._workers = encode, sink, max(1, workers)
-        self._pool = ThreadPoolExecutor(max_workers=self._workers, thread_name_prefix="rend3r-encode")
-        self._pending: deque[Future] = deque()
-
-    def add(self, item: Item) -> None:
-        self._pending.append(self._pool.submit(self._encode, item))
-        while len(self._pending) > self._workers:
-            self._write_oldest()
-
-    def finish(self) -> None:
-        """Write everything added."""
-        while self._pending:
-            self._write_oldest()
-
-    def _write_oldest(self) -> None:
-        for path, data in self._pending.popleft().result():
-            self._sink(path, data)
-
-    def __enter__(self) -> OrderedWriter[Item]:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self._pool.shutdown(wait=True, cancel_futures=True)

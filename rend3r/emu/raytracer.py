@@ -342,7 +342,7 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
         lp.tree, lp.radius, lp.along = sb.bounds.struct(), address(sb.radius), address(sb.along)
         if sb.behind is not None:
             lp.behind, lp.keys = address(sb.behind), address(sb.keys)
-            lp.l_len, lp.l_hat[:] = _unit(light[native.LT_DIR:native.LT_DIR + 3])
+            lp.l_len, lp.l_hat[:] = sb.l_len, sb.l_hat
     c = _report(_run(fr.jobs, n_pix, fr.kernel("light_pass"), lp, _OUT))
     st.shadow_rays += int(c[native.OUT_SHADOW_RAYS])
     st.tests += int(c[native.OUT_TESTS])
@@ -367,6 +367,8 @@ class _ShadowBounds:
     along: np.ndarray  # a directional light's l in normal space and a2, per shape
     behind: np.ndarray | None = None  # a directional light's behind terms per shape
     keys: np.ndarray | None = None  # ... and per node the largest stop keys below it
+    l_len: float = 0.0  # ... and |l| and l / |l| in double
+    l_hat: np.ndarray | None = None
 
 
 def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np.ndarray,
@@ -400,7 +402,7 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
     flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit))
     node_keys = np.empty((fr.tree.nodes, 3))
     lib.bvh_keys(flat.struct(), address(keys), address(node_keys))
-    return _ShadowBounds(radius, flat, along, behind, node_keys)
+    return _ShadowBounds(radius, flat, along, behind, node_keys, length, unit)
 
 
 def _unbounded(fr: _Frame, lp: native.LightPass) -> _ShadowBounds:

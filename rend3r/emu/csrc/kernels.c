@@ -465,7 +465,7 @@ void round16_array(const float *in, float *out, int64_t n, int32_t ftz)
 /* The address of an object's C-contiguous buffer (a numpy array's data), for the ctypes
  * calls: what ndarray.ctypes.data gives without building a ctypes object, in a tenth of
  * its 1.6 us (a frame passes over a hundred addresses). A buffer that is not C-contiguous
- * is refused (BufferError). */
+ * is refused (numpy raises ValueError). */
 static PyObject *address(PyObject *self, PyObject *obj)
 {
     (void)self;

@@ -142,7 +142,6 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
     "shadow_origins": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
     "trace_pixel": (c_int64, [POINTER(Band), c_int32, c_int32, c_void_p, c_void_p, c_int64, c_int64, c_int64,
                               c_void_p, c_void_p, c_void_p]),
-    "finish": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
 }
 _PLAIN = {
     "behind_keys": (None, [c_void_p, c_void_p, c_int64, c_double, c_void_p]),

@@ -14,7 +14,8 @@ not depend on it). Per band:
    row's pixels walking the tree nearest node first);
 4. per light, the hierarchy's boxes for its shadow rays, then the light's colour with
    its shadow rays (``light_pass``);
-5. colours, depth and provenance (``finish``, in the last light's pass when there are lights).
+5. colours, depth and provenance, packet by packet in the last light's pass (in the
+   nearest-hit pass when there are no lights).
 
 ``docs/emulator.md`` sections 4-7 give the order of operations and why the hierarchy
 never changes a pixel; :mod:`.reference` is the plain renderer the tests compare with.
@@ -266,11 +267,12 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
     st = FrameStats()
     w, n_pix, n, dtype = options.width, (row1 - row0) * options.width, len(fr.sf), fr.dtype
     lit = bool(fr.lights)
-    a = {  # the band's arrays; the Band block points into them
-        "slot": np.empty(n_pix, np.int32), "sqd": np.empty(n_pix, dtype),
-        "pt": np.empty((3, n_pix if lit else 0), dtype), "nm": np.empty((3, n_pix if lit else 0), dtype),
-        "bad": np.empty(n_pix, np.uint8), "nan_px": np.empty(n_pix, np.uint8),  # nearest sets every pixel
-        "acc": np.empty((3, n_pix if lit else 0)),  # colour sums per channel; the first light pass sets them
+    kept = n_pix if lit else 0  # without lights, the nearest-hit pass finishes the pixels itself
+    a = {  # the band's arrays; the Band block points into them; nearest sets every pixel's
+        "slot": np.empty(kept, np.int32), "sqd": np.empty(kept, dtype), "pt": np.empty((3, kept), dtype),
+        "nm": np.empty((3, kept), dtype), "bad": np.empty(kept, np.uint8), "nan_px": np.empty(kept, np.uint8),
+        # colour sums per channel between lights (the first light's pass sets them, the last reads them)
+        "acc": np.empty((3, n_pix if len(fr.lights) > 1 else 0)),
     }
     band = native.Band(pointer(fr.shapes), native.ptr(fr.cam, dtype, (native.CAM_COLUMNS,)),
                        native.ptr(fr.xs, dtype, (w,)), native.ptr(fr.ys, dtype, (options.height,)),
@@ -293,10 +295,9 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
     st.tests += int(c[native.OUT_TESTS])
     st.nan_tests += int(c[native.OUT_NAN_TESTS])
     st.skipped += n_pix * n - int(c[native.OUT_TESTS])
-    for k in range(len(fr.lights)):  # the last light's pass finishes the pixels
+    done = c  # the pixels are finished by the nearest-hit pass without lights, else by the last light's
+    for k in range(len(fr.lights)):
         done = _light(fr, options, k, band, c, n_pix, st)
-    if not lit:
-        done = _report(_run(fr.jobs, n_pix, fr.kernel("finish"), band, _OUT))
     st.hits += int(done[native.OUT_SHOWN])
     st.nan_rays += int(done[native.OUT_NAN_RAYS])
     return st

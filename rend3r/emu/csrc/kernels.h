@@ -89,13 +89,16 @@ typedef struct {            /* the primary rays of one band of rows */
     const double *pc;       /* per shape PC_COLUMNS: the primary rays' cull data (bounds.h) */
     const double *floor;    /* depth floor per shape */
     Bvh tree;               /* the shapes, with the primary rays' boxes */
+    /* per pixel, for the light passes (lit only; without lights the nearest-hit pass
+     * finishes the pixels itself): */
     int32_t *slot;          /* nearest shape, -1 none */
     void *sqd;              /* its sq_dist, working */
-    void *pt, *nm;          /* 3 x pixels (x row, y row, z row), working (lit only) */
-    int64_t npix;           /* pixels of the band */
+    void *pt, *nm;          /* 3 x pixels (x row, y row, z row), working */
+    int64_t npix;           /* pixels of the band (lit or not) */
     uint8_t *bad;           /* hit point, or later a light, not finite */
     uint8_t *nan_px;        /* a ray of the pixel met NaN or infinity */
-    double *acc;            /* 3 x pixels colour sums (red row, green row, blue row; lit only) */
+    double *acc;            /* 3 x pixels colour sums (red row, green row, blue row) between lights
+                               (two lights or more) */
     const int32_t *index;   /* program index per shape slot (provenance) */
     int32_t background;     /* RGB565 of pixels that show no shape */
     uint16_t *rgb;          /* the band's pixels: RGB565, depth, provenance */

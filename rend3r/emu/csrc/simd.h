@@ -32,12 +32,26 @@ typedef uint16_t u16x4 __attribute__((vector_size(8)));
 /* Lanes 4h..4h+3 of an eight-lane float mask, as a four-lane double mask. */
 #define I32_HALF(m, h) __builtin_convertvector(                                                    \
     (h) == 0 ? __builtin_shufflevector((m), (m), 0, 1, 2, 3) : __builtin_shufflevector((m), (m), 4, 5, 6, 7), i64x4)
+/* Lanes 4h..4h+3 of an eight-lane int vector. */
+#define I32_QUAD(m, h) \
+    ((h) == 0 ? __builtin_shufflevector((m), (m), 0, 1, 2, 3) : __builtin_shufflevector((m), (m), 4, 5, 6, 7))
 /* Two four-lane double masks as one eight-lane float mask. */
 #define MASK_8(lo, hi) __builtin_shufflevector(__builtin_convertvector((lo), i32x4),                \
                                                __builtin_convertvector((hi), i32x4), 0, 1, 2, 3, 4, 5, 6, 7)
 
 /* Lanes of mask m: from a where set, else from b (integer vectors of one type). */
 #define SEL_BITS(m, a, b) (((a) & (m)) | ((b) & ~(m)))
+
+/* Lane by lane the lesser and the greater of two vectors of numbers (not NaN), and the
+ * least lane of one. */
+INLINE f64x4 min4(f64x4 a, f64x4 b) { return (f64x4)SEL_BITS((i64x4)(a < b), (i64x4)a, (i64x4)b); }
+INLINE f64x4 max4(f64x4 a, f64x4 b) { return (f64x4)SEL_BITS((i64x4)(a > b), (i64x4)a, (i64x4)b); }
+INLINE double least4(f64x4 x)
+{
+    x = min4(x, __builtin_shufflevector(x, x, 2, 3, 0, 1));
+    x = min4(x, __builtin_shufflevector(x, x, 1, 0, 3, 2));
+    return x[0];
+}
 
 /* n consecutive doubles (n <= 4; the last repeated past n), and back. */
 INLINE f64x4 load4(const double *a, int n)

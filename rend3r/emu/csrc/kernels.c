@@ -175,6 +175,14 @@ static void node_add(double *b, int kind, const double *frame, const double *c, 
     }
 }
 
+/* The largest float at most x, as a double (NaN stays NaN): a depth floor that float
+ * lanes compare with their sq_dist stays a lower bound. */
+static double floor32(double x)
+{
+    float w = (float)x;
+    return (double)w > x ? (double)nextafterf(w, -INFINITY) : (double)w;
+}
+
 /* One bundle's node bounds (t->nodes x BV_COLUMNS into box; kind and frame as node_add
  * takes them) from the shapes' cull radii, and each node's least floor (NULL: -inf).
  * Children follow their parent, so nodes go last to first; a cone gets the squared sine
@@ -212,6 +220,7 @@ void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const doub
                 b[BV_FLOOR] = MIN(b[BV_FLOOR], floor != NULL ? floor[s] : -INFINITY);
             }
         }
+        b[BV_FLOOR32] = floor32(b[BV_FLOOR]);
         if (kind == BVH_CONE) {
             double sine = sin(b[BV_ANGLE]);
             b[BV_SIN2] = b[BV_ANGLE] < HALF_PI && b[BV_AXIS] == b[BV_AXIS] ? sine * sine * (1.0 + 1e-9) : INFINITY;
@@ -294,6 +303,7 @@ void primary_shapes(const double *bnd, const uint8_t *ok, int64_t n, const doubl
         c[PC_MEAN2] = (smax * smax + smin * smin) / 2.0;
         c[PC_BEHIND] = r < INFINITY && dist > r ? ((smax * smax - smin * smin) / 2.0 + 64.0 * uu * smax * smax) * dist
                                                 : NAN;
+        c[PC_FLOOR32] = floor32(floor[s]);
     }
 }
 

@@ -26,8 +26,9 @@ enum { CAM_ORIGIN = 0, CAM_TMIN = 3, CAM_TMAX = 4, CAM_Z = 5, CAM_ROT = 6, CAM_C
 enum { LT_KIND = 0, LT_LOC = 1, LT_DIR = 4, LT_INTENSITY = 7, LT_COLUMNS = 8 };
 enum { LIGHT_DIRECTIONAL = 1, LIGHT_POINT = 2 };
 /* Primary cull data per shape (double): centre minus camera, its squared length, the
- * squared cull radius with slack, and the two terms of the behind test (bounds.h). */
-enum { PC_V = 0, PC_VV = 3, PC_R2 = 4, PC_MEAN2 = 5, PC_BEHIND = 6, PC_COLUMNS = 7 };
+ * squared cull radius with slack, the two terms of the behind test (bounds.h), and the
+ * depth floor rounded down to a float (float lanes compare it with sq_dist). */
+enum { PC_V = 0, PC_VV = 3, PC_R2 = 4, PC_MEAN2 = 5, PC_BEHIND = 6, PC_FLOOR32 = 7, PC_COLUMNS = 8 };
 /* Values per shape and per light in a pixel trace. */
 enum { TRACE_SHAPE_VALUES = 22, TRACE_LIGHT_VALUES = 12 };
 /* What a kernel reports per chunk (double): tests, tests that met NaN or infinity, shadow
@@ -61,10 +62,11 @@ typedef struct {
 /* Shape hierarchy node columns (double, per bundle of rays; csrc/bvh.h): a bundle through
  * one apex (BVH_CONE) gets the double cone holding the lines that meet the balls below
  * (unit axis, half-angle, its squared sine), parallel lines (BVH_FLAT) the box of the
- * balls' discs on two axes normal to them; then the least depth floor below. */
+ * balls' discs on two axes normal to them; then the least depth floor below, and that
+ * floor rounded down to a float. */
 enum { BVH_CONE = 0, BVH_FLAT = 1 };
 enum { BV_AXIS = 0, BV_ANGLE = 3, BV_SIN2 = 4, BV_U0 = 0, BV_U1 = 1, BV_V0 = 2, BV_V1 = 3, BV_FLOOR = 5,
-       BV_COLUMNS = 6 };
+       BV_FLOOR32 = 6, BV_COLUMNS = 7 };
 
 typedef struct {
     const int32_t *node;    /* per node: right child (inner) or first item (leaf), item count (0: inner);

@@ -38,7 +38,8 @@ class Tree:
               apex: np.ndarray | None = None, axes: np.ndarray | None = None) -> Bounds:
         """One bundle's node bounds around the balls (centre, ``radius``) of their shapes,
         and their least ``floor`` (None: -inf): the double cones around ``apex`` (lines
-        through it) or the boxes on the two unit ``axes`` (2, 3) normal to parallel lines."""
+        through it) or the boxes on the two unit ``axes`` (2, 3) normal to parallel lines,
+        with each shape's own box too."""
         n = len(bnd)
         native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
         radius = np.ascontiguousarray(radius, np.float64)
@@ -50,10 +51,11 @@ class Tree:
         kind = native.BVH_CONE if apex is not None else native.BVH_FLAT
         frame = np.zeros(6)
         frame[: 3 if apex is not None else 6] = np.ravel(apex if apex is not None else axes)
-        bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame)
+        item_box = np.empty((len(self.items), native.BX_COLUMNS)) if axes is not None else None
+        bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame, item_box)
         native.library().bvh_refit(bounds.struct(), address(bnd), address(radius),
                                    None if floor is None else address(floor), kind, address(frame),
-                                   address(bounds.box))
+                                   address(bounds.box), None if item_box is None else address(item_box))
         return bounds
 
 
@@ -64,12 +66,14 @@ class Bounds:
     tree: Tree
     box: np.ndarray  # (nodes, BV_COLUMNS) float64
     frame: np.ndarray  # 6 float64
+    item_box: np.ndarray | None = None  # parallel lines: (items, BX_COLUMNS), each shape's own box
 
     def struct(self) -> native.Bvh:
         """The kernels' view (the arrays must outlive it)."""
         t = self.tree
         return native.Bvh(address(t.node), address(t.items), address(self.box), (*self.frame,), t.nodes,
-                          address(t.always), len(t.always))
+                          address(t.always), len(t.always),
+                          None if self.item_box is None else address(self.item_box))
 
 
 def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:

@@ -38,6 +38,7 @@ OUT_SHOWN, OUT_NAN_RAYS, OUT_COLUMNS = 10, 11, 12
 PC_COLUMNS = 8
 BVH_CONE, BVH_FLAT = 0, 1  # a hierarchy's bounds around lines through one apex, or parallel lines
 BV_ANGLE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 4, 5, 7  # their columns (csrc/kernels.h)
+BX_COLUMNS = 4  # a shape's own box on the axes normal to parallel lines
 
 
 class Format(Structure):
@@ -73,7 +74,7 @@ class Shapes(Structure):
 
 class Bvh(Structure):
     _fields_ = [("node", c_void_p), ("items", c_void_p), ("box", c_void_p), ("frame", c_double * 6),
-                ("nodes", c_int64), ("always", c_void_p), ("nalways", c_int64)]
+                ("nodes", c_int64), ("always", c_void_p), ("nalways", c_int64), ("item_box", c_void_p)]
 
 
 class Band(Structure):
@@ -147,7 +148,7 @@ _PLAIN = {
     "behind_keys": (None, [c_void_p, c_void_p, c_int64, c_double, c_void_p]),
     "bvh_keys": (None, [POINTER(Bvh), c_void_p, c_void_p]),
     "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p]),
-    "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_void_p, c_void_p, c_int32, c_void_p, c_void_p]),
+    "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_void_p, c_void_p, c_int32, c_void_p, c_void_p, c_void_p]),
     "primary_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,
                               c_void_p, c_void_p, c_void_p]),
     "shadow_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,

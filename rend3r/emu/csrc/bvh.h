@@ -9,7 +9,8 @@
  * parallel lines (a directional light's) the box holding the balls' discs on two axes
  * normal to them. A line outside a node's bound passes farther than the cull radius
  * from every centre below it, so each of those shapes is provably missed, as the
- * per-shape tests would find; and a node's floor is the least depth floor below it: a
+ * per-shape tests would find (parallel lines also get each shape's own box, a leaf of
+ * one, which shadow packets test before a shape's own tests); and a node's floor is the least depth floor below it: a
  * node whose floor lies beyond every lane's nearest hit
  * holds no shape that can win or tie. Skipping such nodes changes which shapes are
  * tested, never the nearest hit (the tie rule orders by index, not by testing order).

@@ -184,11 +184,13 @@ static double floor32(double x)
 }
 
 /* One bundle's node bounds (t->nodes x BV_COLUMNS into box; kind and frame as node_add
- * takes them) from the shapes' cull radii, and each node's least floor (NULL: -inf).
+ * takes them) from the shapes' cull radii, and each node's least floor (NULL: -inf); for
+ * parallel lines (BVH_FLAT) also each shape's own box into item_box (items x BX_COLUMNS,
+ * in leaf order) unless it is NULL.
  * Children follow their parent, so nodes go last to first; a cone gets the squared sine
  * of its half-angle (inf from pi/2 on: every line) for the kernels' test. */
 void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const double *floor, int32_t kind,
-               const double *frame, double *box)
+               const double *frame, double *box, double *item_box)
 {
     for (int64_t at = t->nodes - 1; at >= 0; at--) {
         double *b = box + BV_COLUMNS * at;
@@ -216,8 +218,15 @@ void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const doub
         } else {
             for (int32_t i = first; i < first + count; i++) {
                 int64_t s = t->items[i];
-                node_add(b, kind, frame, bnd + B_COLUMNS * s, radius[s] == radius[s] ? radius[s] : INFINITY);
+                double r = radius[s] == radius[s] ? radius[s] : INFINITY;
+                node_add(b, kind, frame, bnd + B_COLUMNS * s, r);
                 b[BV_FLOOR] = MIN(b[BV_FLOOR], floor != NULL ? floor[s] : -INFINITY);
+                if (item_box != NULL) {  /* the shape's own box, as its leaf's holds it */
+                    double *o = item_box + BX_COLUMNS * (int64_t)i;
+                    o[BV_U0] = o[BV_V0] = INFINITY;
+                    o[BV_U1] = o[BV_V1] = -INFINITY;
+                    node_add(o, kind, frame, bnd + B_COLUMNS * s, r);
+                }
             }
         }
         b[BV_FLOOR32] = floor32(b[BV_FLOOR]);

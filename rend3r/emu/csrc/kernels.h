@@ -67,6 +67,8 @@ typedef struct {
 enum { BVH_CONE = 0, BVH_FLAT = 1 };
 enum { BV_AXIS = 0, BV_ANGLE = 3, BV_SIN2 = 4, BV_U0 = 0, BV_U1 = 1, BV_V0 = 2, BV_V1 = 3, BV_FLOOR = 5,
        BV_FLOOR32 = 6, BV_COLUMNS = 7 };
+/* Parallel lines also get each shape's own box (BV_U0..BV_V1), per item in leaf order. */
+enum { BX_COLUMNS = 4 };
 
 typedef struct {
     const int32_t *node;    /* per node: right child (inner) or first item (leaf), item count (0: inner);
@@ -77,6 +79,7 @@ typedef struct {
     int64_t nodes;
     const int32_t *always;  /* shape slots outside the tree (no finite bound): every ray tests them */
     int64_t nalways;
+    const double *item_box; /* parallel lines: items x BX_COLUMNS, each shape's own box (else NULL) */
 } Bvh;
 
 typedef struct {            /* the primary rays of one band of rows */

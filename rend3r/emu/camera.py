@@ -12,10 +12,9 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from ..isa import Table
 from .arith import Arith
 from .options import EmuOptions
-from .scene import Scene, prop_index
+from .scene import Scene
 from .vec import Quat, Vec, rotate
 
 #: The device's ray generator: start values and the step added once per pixel (float16 bits).
@@ -55,12 +54,30 @@ class Rays:
         return cam if self.rotation is None else rotate(self.arith, self.rotation, cam)
 
 
+#: The camera properties the rays depend on.
+_RAY_PROPS = ("xloc", "yloc", "zloc", "rrot", "irot", "jrot", "krot", "nclip", "hfov", "vfov", "fclip")
+
+
 def camera_rays(scene: Scene, options: EmuOptions, arith: Arith) -> Rays:
-    """The primary rays of the frame, by the camera model the options select."""
-    origin = tuple(arith.from_bits(scene.camera_bits(n)) for n in ("xloc", "yloc", "zloc"))
-    if options.camera == "device":
-        return _device_rays(origin, options.width, options.height, arith)
-    return _spec_rays(scene, origin, options.width, options.height, arith)
+    """The primary rays of the frame, by the camera model the options select. The same
+    camera gives the same rays, so the last few are kept for the frames and runs after
+    (their arrays are read-only)."""
+    bits = tuple(scene.camera_bits(n) for n in _RAY_PROPS)
+    return _rays(bits, options.camera, options.width, options.height, arith)
+
+
+@lru_cache(maxsize=8)
+def _rays(bits: tuple[int, ...], model: str, width: int, height: int, arith: Arith) -> Rays:
+    """camera_rays for the camera properties' bits (in _RAY_PROPS order)."""
+    cam = dict(zip(_RAY_PROPS, bits))
+    origin = tuple(arith.from_bits(cam[n]) for n in ("xloc", "yloc", "zloc"))
+    if model == "device":
+        rays = _device_rays(origin, width, height, arith)
+    else:
+        rays = _spec_rays(cam, origin, width, height, arith)
+    for a in (rays.xs, rays.ys):
+        a.flags.writeable = False
+    return rays
 
 
 @lru_cache(maxsize=16)
@@ -85,14 +102,22 @@ def _device_rays(origin: Vec, width: int, height: int, arith: Arith) -> Rays:
 
 def camera_value(scene: Scene, name: str, arith: Arith, default: float) -> np.ndarray:
     """A camera property's value; zero (as memory starts) means the default."""
-    v = arith.from_bits(scene.camera.get(prop_index(Table.CAMERA, name), 0))
+    return _value(scene.camera_bits(name), arith, default)
+
+
+def _value(bits: int, arith: Arith, default: float) -> np.ndarray:
+    v = arith.from_bits(bits)
     return arith.const(default) if float(v) == 0.0 else v
 
 
 def camera_quaternion(scene: Scene, arith: Arith) -> Quat | None:
     """The camera's rotation, normalised; None for no rotation (i = j = k = 0, which
     includes the all-zero quaternion of unset memory)."""
-    q = [arith.from_bits(scene.camera_bits(n)) for n in ("rrot", "irot", "jrot", "krot")]
+    return _quaternion([scene.camera_bits(n) for n in ("rrot", "irot", "jrot", "krot")], arith)
+
+
+def _quaternion(bits: list[int], arith: Arith) -> Quat | None:
+    q = [arith.from_bits(b) for b in bits]
     if all(float(c) == 0.0 for c in q[1:]):
         return None
     r, i, j, k = q
@@ -126,14 +151,16 @@ def _viewport_axes(arith: Arith, width: int, height: int) -> tuple[np.ndarray, n
     return ux, uy
 
 
-def _spec_rays(scene: Scene, origin: Vec, width: int, height: int, arith: Arith) -> Rays:
-    """Camera space (ux*hfov*n, uy*vfov*n, -n) rotated by q; t = 1 is the near plane."""
-    near = camera_value(scene, "nclip", arith, 1.0)
-    hfov = camera_value(scene, "hfov", arith, 1.0)
-    vfov = camera_value(scene, "vfov", arith, 1.0)
+def _spec_rays(cam: dict[str, int], origin: Vec, width: int, height: int, arith: Arith) -> Rays:
+    """Camera space (ux*hfov*n, uy*vfov*n, -n) rotated by q; t = 1 is the near plane
+    (cam: the camera properties' bits by name)."""
+    near = _value(cam["nclip"], arith, 1.0)
+    hfov = _value(cam["hfov"], arith, 1.0)
+    vfov = _value(cam["vfov"], arith, 1.0)
     ux, uy = _viewport_axes(arith, width, height)
     cx = arith.mul(arith.mul(ux, hfov), near)
     cy = arith.mul(arith.mul(uy, vfov), near)
-    far = arith.from_bits(scene.camera_bits("fclip"))
+    far = arith.from_bits(cam["fclip"])
     tmax = arith.const(np.inf) if float(far) == 0.0 else arith.div(far, near)
-    return Rays(origin, cx, cy, arith.neg(near), camera_quaternion(scene, arith), arith.const(1.0), tmax, arith)
+    rotation = _quaternion([cam[n] for n in ("rrot", "irot", "jrot", "krot")], arith)
+    return Rays(origin, cx, cy, arith.neg(near), rotation, arith.const(1.0), tmax, arith)

@@ -41,6 +41,23 @@ static inline i64x4 cone_missed4(const double *b, f64x4 w0, f64x4 w1, f64x4 w2, 
     return c0 * c0 + c1 * c1 + c2 * c2 > ww * b[BV_SIN2];
 }
 
+/* cone_missed4 for eight float directions w (ww: w.w in float, in [2**-100, 2**100] on
+ * every lane), in float: the axis rounded to floats (each component within u = 2**-24 of
+ * its own), the products and sums rounded. Each computed component of w x axis is then
+ * within 3u|w| of the exact one, the rounded axis adds at most u|w|, so the computed cross
+ * product lies within 7u|w| of the exact one; the sum of its squares and ww x sin2 carry
+ * relative errors of at most 3.1u and 4u. The node's squared sine is widened to
+ * (sin + 8u)^2 (1 + 10u), rounded up (kernels.c bvh_refit), so a lane reported outside has
+ * |w x axis| + 7u|w| > |w| (sin + 8u): outside the cone, as the double test would find.
+ * Within that range no product overflows and none underflows by more than 2**-149, far
+ * below u|w|. NaN never lies outside. */
+static inline i32x8 cone_missed8(const double *b, f32x8 w0, f32x8 w1, f32x8 w2, f32x8 ww)
+{
+    float a0 = (float)b[BV_AXIS32], a1 = (float)b[BV_AXIS32 + 1], a2 = (float)b[BV_AXIS32 + 2];
+    f32x8 c0 = w1 * a2 - w2 * a1, c1 = w2 * a0 - w0 * a2, c2 = w0 * a1 - w1 * a0;
+    return c0 * c0 + c1 * c1 + c2 * c2 > ww * (float)b[BV_SIN2_32];
+}
+
 /* Lanes whose parallel line, at (u, v) on the axes normal to the lines, lies outside a
  * node's box. NaN never lies outside. */
 static inline i64x4 flat_missed4(const double *b, f64x4 u, f64x4 v)

@@ -26,13 +26,19 @@ static inline i32x4 pack_rgb4(const f64x4 acc[3])
     return value;
 }
 
-/* Lanes on: one light's share of shape colours base (RGB565) added to the sums,
+/* The channels of RGB565 colours, in double. */
+static inline void channels4(i32x4 base, f64x4 channel[3])
+{
+    for (int c = 0; c < 3; c++)
+        channel[c] = __builtin_convertvector((base >> rgb_shift[c]) & rgb_top[c], f64x4);
+}
+
+/* Lanes on: one light's share of shape colours (channels) added to the sums,
  * factor * channel * scale per channel, in double. */
-static inline void add_light4(f64x4 acc[3], f64x4 factor, i32x4 base, const double *scale, i64x4 on)
+static inline void add_light4(f64x4 acc[3], f64x4 factor, const f64x4 channel[3], const double *scale, i64x4 on)
 {
     for (int c = 0; c < 3; c++) {
-        f64x4 channel = __builtin_convertvector((base >> rgb_shift[c]) & rgb_top[c], f64x4);
-        f64x4 sum = acc[c] + factor * channel * scale[c];
+        f64x4 sum = acc[c] + factor * channel[c] * scale[c];
         acc[c] = (f64x4)SEL_BITS(on, (i64x4)sum, (i64x4)acc[c]);
     }
 }

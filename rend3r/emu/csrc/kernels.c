@@ -183,6 +183,16 @@ static double floor32(double x)
     return (double)w > x ? (double)nextafterf(w, -INFINITY) : (double)w;
 }
 
+/* The least float at least x, as a double. */
+static double ceil32(double x)
+{
+    float w = (float)x;
+    return (double)w < x ? (double)nextafterf(w, INFINITY) : (double)w;
+}
+
+/* A float's unit roundoff, 2**-24. */
+#define U32 5.9604644775390625e-08
+
 /* One bundle's node bounds (t->nodes x BV_COLUMNS into box; kind and frame as node_add
  * takes them) from the shapes' cull radii, and each node's least floor (NULL: -inf); for
  * parallel lines (BVH_FLAT) also each shape's own box into item_box (items x BX_COLUMNS,
@@ -232,7 +242,12 @@ void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const doub
         b[BV_FLOOR32] = floor32(b[BV_FLOOR]);
         if (kind == BVH_CONE) {
             double sine = sin(b[BV_ANGLE]);
-            b[BV_SIN2] = b[BV_ANGLE] < HALF_PI && b[BV_AXIS] == b[BV_AXIS] ? sine * sine * (1.0 + 1e-9) : INFINITY;
+            int cone = b[BV_ANGLE] < HALF_PI && b[BV_AXIS] == b[BV_AXIS];
+            b[BV_SIN2] = cone ? sine * sine * (1.0 + 1e-9) : INFINITY;
+            for (int c = 0; c < 3; c++)
+                b[BV_AXIS32 + c] = (float)b[BV_AXIS + c];
+            b[BV_SIN2_32] = cone ? ceil32((sine * (1.0 + 1e-9) + 8 * U32) * (sine * (1.0 + 1e-9) + 8 * U32)
+                                          * (1.0 + 10 * U32)) : INFINITY;
         }
     }
 }

@@ -63,10 +63,11 @@ typedef struct {
  * one apex (BVH_CONE) gets the double cone holding the lines that meet the balls below
  * (unit axis, half-angle, its squared sine), parallel lines (BVH_FLAT) the box of the
  * balls' discs on two axes normal to them; then the least depth floor below, and that
- * floor rounded down to a float. */
+ * floor rounded down to a float; a cone also gets its axis rounded to floats and the
+ * widened squared sine of the float test (bvh.h cone_missed8). */
 enum { BVH_CONE = 0, BVH_FLAT = 1 };
 enum { BV_AXIS = 0, BV_ANGLE = 3, BV_SIN2 = 4, BV_U0 = 0, BV_U1 = 1, BV_V0 = 2, BV_V1 = 3, BV_FLOOR = 5,
-       BV_FLOOR32 = 6, BV_COLUMNS = 7 };
+       BV_FLOOR32 = 6, BV_AXIS32 = 7, BV_SIN2_32 = 10, BV_COLUMNS = 11 };
 /* Parallel lines also get each shape's own box (BV_U0..BV_V1), per item in leaf order. */
 enum { BX_COLUMNS = 4 };
 

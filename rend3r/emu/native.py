@@ -38,7 +38,7 @@ OUT_SHOWN, OUT_NAN_RAYS, OUT_COLUMNS = 10, 11, 12
 PC_COLUMNS = 8
 BVH_CONE, BVH_FLAT = 0, 1  # a hierarchy's bounds around lines through one apex, or parallel lines
 BV_ANGLE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 4, 5, 11  # their columns (csrc/kernels.h)
-BX_COLUMNS = 4  # a shape's own box on the axes normal to parallel lines
+BX_COLUMNS = 8  # a shape's own box on the axes normal to parallel lines (and rounded to floats)
 
 
 class Format(Structure):

@@ -58,6 +58,15 @@ static inline i32x8 cone_missed8(const double *b, f32x8 w0, f32x8 w1, f32x8 w2, 
     return c0 * c0 + c1 * c1 + c2 * c2 > ww * (float)b[BV_SIN2_32];
 }
 
+/* flat_missed4 for eight lanes in float: u and v rounded to floats, the box b32 (u0, u1,
+ * v0, v1) rounded outwards (kernels.c box32). Rounding is monotonic, so u >= u0 gives
+ * fl(u) >= fl(u0) >= b32[0], and likewise at the other sides: a lane inside the box is
+ * never reported outside, whatever the magnitudes (overflow included). */
+static inline i32x8 flat_missed8(const double *b32, f32x8 u, f32x8 v)
+{
+    return (u < (float)b32[0]) | (u > (float)b32[1]) | (v < (float)b32[2]) | (v > (float)b32[3]);
+}
+
 /* Lanes whose parallel line, at (u, v) on the axes normal to the lines, lies outside a
  * node's box. NaN never lies outside. */
 static inline i64x4 flat_missed4(const double *b, f64x4 u, f64x4 v)

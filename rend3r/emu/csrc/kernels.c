@@ -190,6 +190,13 @@ static double ceil32(double x)
     return (double)w < x ? (double)nextafterf(w, INFINITY) : (double)w;
 }
 
+/* A box's bounds (u0, u1, v0, v1) rounded outwards to floats, at out. */
+static void box32(const double *b, double *out)
+{
+    out[0] = floor32(b[BV_U0]); out[1] = ceil32(b[BV_U1]);
+    out[2] = floor32(b[BV_V0]); out[3] = ceil32(b[BV_V1]);
+}
+
 /* A float's unit roundoff, 2**-24. */
 #define U32 5.9604644775390625e-08
 
@@ -236,10 +243,13 @@ void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const doub
                     o[BV_U0] = o[BV_V0] = INFINITY;
                     o[BV_U1] = o[BV_V1] = -INFINITY;
                     node_add(o, kind, frame, bnd + B_COLUMNS * s, r);
+                    box32(o, o + BX_BOX32);
                 }
             }
         }
         b[BV_FLOOR32] = floor32(b[BV_FLOOR]);
+        if (kind == BVH_FLAT)
+            box32(b, b + BV_BOX32);
         if (kind == BVH_CONE) {
             double sine = sin(b[BV_ANGLE]);
             int cone = b[BV_ANGLE] < HALF_PI && b[BV_AXIS] == b[BV_AXIS];

@@ -7,9 +7,10 @@ the threads (every pixel is computed the same way whatever the split, so the ima
 not depend on it). Per band:
 
 1. the primary directions' shortest and longest length (``directions`` stores a rotated
-   camera's directions);
+   camera's directions; a grid camera's come from its axes, once per frame);
 2. the shape hierarchy's boxes for the primary rays, from the shapes' cull radii and
-   depth floors (:mod:`.bvh`, :mod:`.bounds`; the tree itself is built once per frame);
+   depth floors (:mod:`.bvh`, :mod:`.bounds`; the tree itself is built once per frame,
+   and for a grid camera these bounds too, shared by its bands);
 3. the nearest hit of every pixel, its hit point and normal (``nearest``, packets of a
    row's pixels walking the tree nearest node first);
 4. per light, the hierarchy's boxes for its shadow rays, then the light's colour with
@@ -97,6 +98,8 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
         if fr.jobs > 1 and len(fr.sf) * PIXELS_PER_SHAPE <= n_pix:  # a band per thread at least
             rows = min(rows, -(-h // fr.jobs))
         bands = [(row0, min(h, row0 + rows)) for row0 in range(0, h, rows)]
+        extent = _extent(fr, 0, h)  # a grid camera's bands share one set of primary bounds
+        primary = _primary_tree(fr, *extent) if extent is not None else None
         if len(bands) == 1:
             work = [(*bands[0], fr, None)]
         else:  # bands on the threads, their work single-threaded; with a band per thread at
@@ -106,11 +109,11 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
             pool = fr.jobs - 1 if own else fr.jobs
             work = [(row0, row1, one, None if own and k == 0 else threads.submit(
                 pool, _band, one, options, row0, row1, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
-                prov[row0 * w:row1 * w])) for k, (row0, row1) in enumerate(bands)]
+                prov[row0 * w:row1 * w], primary)) for k, (row0, row1) in enumerate(bands)]
         for row0, row1, frame, future in work:
             _add(st, future.result() if future is not None else _band(
                 frame, options, row0, row1, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
-                prov[row0 * w:row1 * w]))
+                prov[row0 * w:row1 * w], primary))
             if progress is not None:
                 progress(row1 / h)
     st.seconds = perf_counter() - start
@@ -262,8 +265,9 @@ _BAND_COUNTS = ("tests", "skipped", "nan_tests", "nan_rays", "hits", "shadow_ray
 
 
 def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray, depth: np.ndarray,
-          prov: np.ndarray) -> FrameStats:
-    """Render rows row0..row1 into the band's slices of the frame; returns its counts."""
+          prov: np.ndarray, primary: _Primary | None = None) -> FrameStats:
+    """Render rows row0..row1 into the band's slices of the frame; returns its counts.
+    ``primary``: the frame's primary bounds (None: the band measures its directions)."""
     st = FrameStats()
     w, n_pix, n, dtype = options.width, (row1 - row0) * options.width, len(fr.sf), fr.dtype
     lit = bool(fr.lights)
@@ -278,14 +282,14 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
                        native.ptr(fr.xs, dtype, (w,)), native.ptr(fr.ys, dtype, (options.height,)),
                        int(fr.rotated), int(lit), w, row0, native.row_magic(w))
     band.npix = n_pix
-    extent = _extent(fr, row0, row1)
-    if extent is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
+    if primary is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
         a["dirs"] = np.empty((n_pix, 4), dtype)
         band.dirs = address(a["dirs"])
         parts = _run(fr.jobs, n_pix, fr.kernel("directions"), band, np.array([0.0, np.inf, 0.0]))
         extent = (float(parts[:, 1].min()), float(parts[:, 2].max())) if parts[:, 0].sum() else (0.0, 0.0)
-    primary, floor, pc = _primary_tree(fr, *extent)
-    band.pc, band.floor, band.tree = address(pc), address(floor), primary.struct()
+        primary = _primary_tree(fr, *extent)
+    tree, floor, pc = primary
+    band.pc, band.floor, band.tree = address(pc), address(floor), tree.struct()
     for name in ("slot", "sqd", "pt", "nm", "bad", "nan_px", "acc"):
         setattr(band, name, address(a[name]))
     band.index, band.background = address(fr.index), options.background
@@ -303,6 +307,11 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
     return st
 
 
+#: A frame's (or band's) primary bounds: the hierarchy's, and per shape its depth floor
+#: and cull data (_primary_tree).
+_Primary = tuple[bvh.Bounds, np.ndarray, np.ndarray]
+
+
 def _extent(fr: _Frame, row0: int, row1: int) -> tuple[float, float] | None:
     """The shortest and longest primary direction of rows row0..row1 for a camera whose
     directions are (x[col], y[row], z), all finite and z not zero; None for other cameras
@@ -315,7 +324,7 @@ def _extent(fr: _Frame, row0: int, row1: int) -> tuple[float, float] | None:
             float(np.sqrt(np.max(xs**2) + np.max(ys**2) + z * z)))
 
 
-def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> tuple[bvh.Bounds, np.ndarray, np.ndarray]:
+def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> _Primary:
     """The hierarchy's bounds for the primary rays (directions dmin..dmax long), and per
     shape its depth floor and cull data."""
     apex = fr.cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)  # at infinity: nothing is bounded

@@ -25,6 +25,7 @@ typedef int32_t i32x4 __attribute__((vector_size(16)));
 typedef uint32_t u32x4 __attribute__((vector_size(16)));
 typedef float f32x4 __attribute__((vector_size(16)));
 typedef uint16_t u16x4 __attribute__((vector_size(8)));
+typedef uint16_t u16x8 __attribute__((vector_size(16)));
 
 /* Lanes 4h..4h+3 of a float packet, in double. */
 #define F32_HALF(v, h) __builtin_convertvector(                                                    \
@@ -32,9 +33,6 @@ typedef uint16_t u16x4 __attribute__((vector_size(8)));
 /* Lanes 4h..4h+3 of an eight-lane float mask, as a four-lane double mask. */
 #define I32_HALF(m, h) __builtin_convertvector(                                                    \
     (h) == 0 ? __builtin_shufflevector((m), (m), 0, 1, 2, 3) : __builtin_shufflevector((m), (m), 4, 5, 6, 7), i64x4)
-/* Lanes 4h..4h+3 of an eight-lane int vector. */
-#define I32_QUAD(m, h) \
-    ((h) == 0 ? __builtin_shufflevector((m), (m), 0, 1, 2, 3) : __builtin_shufflevector((m), (m), 4, 5, 6, 7))
 /* Two four-lane double masks as one eight-lane float mask. */
 #define MASK_8(lo, hi) __builtin_shufflevector(__builtin_convertvector((lo), i32x4),                \
                                                __builtin_convertvector((hi), i32x4), 0, 1, 2, 3, 4, 5, 6, 7)

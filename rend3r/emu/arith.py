@@ -103,7 +103,7 @@ class Arith:
     def dtype(self) -> type[np.floating]:
         return np.float32 if self.native and self.precision != "fp64" else np.float64
 
-    @property
+    @cached_property
     def unit_roundoff(self) -> float:
         """Half an ulp of 1: the largest relative error of one rounding (normal range), as
         the culling bounds use it. Per stage: 4 times the largest of the formats', since an
@@ -113,13 +113,13 @@ class Arith:
             return self.format.unit_roundoff
         return 4 * max(f.unit_roundoff for f in (self.format, *self.stage_formats.values()))
 
-    @property
+    @cached_property
     def tiny(self) -> float:
         """The smallest normal number (per stage: the largest of the formats'): below it
         results flush or lose relative precision."""
         return max(f.min_normal for f in (self.format, *self.stage_formats.values()))
 
-    @property
+    @cached_property
     def overflow(self) -> float:
         """The overflow threshold (per stage: the largest of the formats'), which the
         culling bounds take as a limit of any finite product."""

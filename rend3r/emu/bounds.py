@@ -10,6 +10,8 @@ zero depth floor, so every ray tests it.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import native, threads
@@ -49,10 +51,10 @@ def shadow(table: np.ndarray, ok: np.ndarray, lo: np.ndarray, hi: np.ndarray, dm
     LightPass.behind), else None."""
     n = len(table)
     table, flags = _inputs(table, ok)
-    with np.errstate(all="ignore"):
-        mid = np.ascontiguousarray((lo + hi) / 2, np.float64)
-        half = float(np.sqrt(((hi - lo) ** 2).sum()) / 2)
-        magnitude = float(max(np.abs(lo).max(), np.abs(hi).max()))  # of any origin's coordinates
+    lo3, hi3 = [float(c) for c in lo], [float(c) for c in hi]  # 3-vectors: plain arithmetic
+    mid = np.array([(a + b) / 2 for a, b in zip(lo3, hi3)])
+    half = math.sqrt(sum((b - a) * (b - a) for a, b in zip(lo3, hi3))) / 2
+    magnitude = max(abs(c) for c in lo3 + hi3)  # of any origin's coordinates
     if unit is not None:
         unit = np.ascontiguousarray(unit, np.float64)
         native.ptr(unit, np.float64, (3,))

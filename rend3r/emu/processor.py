@@ -16,6 +16,7 @@ bound.
 
 from __future__ import annotations
 
+import threading
 from array import array
 from ctypes import byref
 from dataclasses import dataclass
@@ -87,7 +88,7 @@ class _Writes:
     bits: np.ndarray
 
     def between(self, lo: int, hi: int) -> _Writes:
-        i, j = np.searchsorted(self.at, (lo, hi))
+        i, j = self.at.searchsorted((lo, hi))
         return _Writes(self.at[i:j], self.index[i:j], self.prop[i:j], self.bits[i:j])
 
     def take(self, keep: np.ndarray) -> _Writes:
@@ -155,7 +156,7 @@ class _Stream:
 
     def executed_before(self, at: int) -> int:
         """Instructions of this stream that start before address ``at``."""
-        return sum(int(np.searchsorted(a, at)) for a in self.by_kind)
+        return sum(int(a.searchsorted(at)) for a in self.by_kind)
 
     def error(self) -> Rend3rError:
         """The error at ``stop`` (kind "error")."""
@@ -180,12 +181,12 @@ class _Stream:
 
     def table_after(self, entry: int) -> int:
         """The table code in force at ``stop`` for a pass entered with ``entry``."""
-        return int(self.ts_codes[np.searchsorted(self.ts_at, self.stop)]) or entry
+        return int(self.ts_codes[self.ts_at.searchsorted(self.stop)]) or entry
 
     def _data(self, kind: int) -> np.ndarray:
         """Addresses of the instructions of ``kind`` (_KIND) before ``stop``."""
         at = self.by_kind[kind]
-        return at[:np.searchsorted(at, self.stop)]
+        return at[:at.searchsorted(self.stop)]
 
     @cached_property
     def camera(self) -> _Writes:
@@ -206,7 +207,7 @@ class _Stream:
         table); None when the stream has no TS word."""
         if not len(self.ts_at):
             return None
-        return np.ascontiguousarray(self.ts_codes[np.searchsorted(self.ts_at, at)], np.uint8)
+        return np.ascontiguousarray(self.ts_codes[self.ts_at.searchsorted(at)], np.uint8)
 
 
 #: (lo, width) of the fields the pair kernels read, in their order (csrc/kernels.c Pairs).
@@ -219,6 +220,18 @@ _WANTED = {True: (1 - _TRIANGLE_CODE, _TRIANGLE_CODE),
            False: (np.ones(len(_TABLES) + 1, np.uint8), np.zeros(len(_TABLES) + 1, np.uint8))}
 
 
+_MARKS = threading.local()
+
+
+def _marks() -> np.ndarray:
+    """This thread's mark array for pair_marks (SHAPE_INDEX_LIMIT bytes, all zero), kept
+    for the next write: zeroing half a megabyte for each pass cost more than the pass."""
+    mark = getattr(_MARKS, "mark", None)
+    if mark is None:
+        mark = _MARKS.mark = np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
+    return mark
+
+
 def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, entry: int, wanted: np.ndarray,
                  table: ObjectTable) -> None:
     """Apply the SE/SD pairs at ``at`` (each writes prop then prop2; a write to a null
@@ -229,13 +242,17 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
     pairs = native.Pairs(address(words), len(words), address(at), len(at), address(_PAIR_FIELDS),
                          None if tables is None else address(tables), entry, address(wanted),
                          address(_SE_NULL))
-    lib, mark = native.library(), np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
-    top = lib.pair_marks(byref(pairs), address(mark))
-    if top < 0:
-        raise Rend3rError(f"{_where(int(at[-1 - top]))}: an SE word without its SD")
-    if top:
-        row_of = table.grow(mark, top)
-        lib.pair_apply(byref(pairs), address(row_of), native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))
+    lib, mark, top = native.library(), _marks(), -1
+    try:
+        top = lib.pair_marks(byref(pairs), address(mark))
+        if top < 0:
+            raise Rend3rError(f"{_where(int(at[-1 - top]))}: an SE word without its SD")
+        if top:
+            row_of = table.grow(mark, top)
+            lib.pair_apply(byref(pairs), address(row_of), native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))
+    finally:  # the marks lie below the largest index written and the table's largest (grow's)
+        last = int(table.index[-1]) + 1 if len(table.index) else 0
+        mark[:SHAPE_INDEX_LIMIT if top < 0 else max(top, last)] = 0
 
 
 @dataclass(frozen=True)
@@ -275,7 +292,7 @@ def _apply(stream: _Stream, lo: int, hi: int, scene: Scene, entry: int) -> None:
     """Apply the writes of addresses [lo, hi) of ``stream`` (``entry``: the table code in
     force when the pass started)."""
     if stream.prog.options.clear_on_nr:
-        i, j = np.searchsorted(stream.nr, (lo, hi))
+        i, j = stream.nr.searchsorted((lo, hi))
         if j > i:
             scene.clear()
             lo = int(stream.nr[j - 1]) + 1
@@ -285,7 +302,7 @@ def _apply(stream: _Stream, lo: int, hi: int, scene: Scene, entry: int) -> None:
     if len(lights.at):
         scene.write_lights(lights.index, lights.prop, lights.bits)
     pairs = stream.by_kind[_PAIR]
-    at = pairs[np.searchsorted(pairs, lo):np.searchsorted(pairs, hi)]  # hi <= stop
+    at = pairs[pairs.searchsorted(lo):pairs.searchsorted(hi)]  # hi <= stop
     if len(at):
         tables = stream.pair_tables(at)
         for table, wanted in zip((scene.objects, scene.triangles), _WANTED[stream.prog.options.mode == "hybrid"]):

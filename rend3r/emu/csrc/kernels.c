@@ -175,19 +175,34 @@ static void node_add(double *b, int kind, const double *frame, const double *c, 
     }
 }
 
+/* The float next to w towards -infinity (down) or +infinity, w not NaN and not at that
+ * end: its bits step away from zero on the side it moves to, towards zero on the other,
+ * and a zero becomes the smallest subnormal of that sign (nextafterf, without a call). */
+static float step32(float w, int down)
+{
+    uint32_t b;
+    memcpy(&b, &w, sizeof b);
+    if (w == 0)
+        b = down ? 0x80000001u : 1u;
+    else
+        b = (w > 0) != down ? b + 1 : b - 1;
+    memcpy(&w, &b, sizeof w);
+    return w;
+}
+
 /* The largest float at most x, as a double (NaN stays NaN): a depth floor that float
  * lanes compare with their sq_dist stays a lower bound. */
 static double floor32(double x)
 {
     float w = (float)x;
-    return (double)w > x ? (double)nextafterf(w, -INFINITY) : (double)w;
+    return (double)w > x ? (double)step32(w, 1) : (double)w;
 }
 
 /* The least float at least x, as a double. */
 static double ceil32(double x)
 {
     float w = (float)x;
-    return (double)w < x ? (double)nextafterf(w, INFINITY) : (double)w;
+    return (double)w < x ? (double)step32(w, 0) : (double)w;
 }
 
 /* A box's bounds (u0, u1, v0, v1) rounded outwards to floats, at out. */
@@ -236,15 +251,18 @@ void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const doub
             for (int32_t i = first; i < first + count; i++) {
                 int64_t s = t->items[i];
                 double r = radius[s] == radius[s] ? radius[s] : INFINITY;
-                node_add(b, kind, frame, bnd + B_COLUMNS * s, r);
                 b[BV_FLOOR] = MIN(b[BV_FLOOR], floor != NULL ? floor[s] : -INFINITY);
-                if (item_box != NULL) {  /* the shape's own box, as its leaf's holds it */
-                    double *o = item_box + BX_COLUMNS * (int64_t)i;
-                    o[BV_U0] = o[BV_V0] = INFINITY;
-                    o[BV_U1] = o[BV_V1] = -INFINITY;
-                    node_add(o, kind, frame, bnd + B_COLUMNS * s, r);
-                    box32(o, o + BX_BOX32);
+                if (item_box == NULL) {
+                    node_add(b, kind, frame, bnd + B_COLUMNS * s, r);
+                    continue;
                 }
+                double *o = item_box + BX_COLUMNS * (int64_t)i;  /* the shape's own box, then the leaf's */
+                o[BV_U0] = o[BV_V0] = INFINITY;
+                o[BV_U1] = o[BV_V1] = -INFINITY;
+                node_add(o, kind, frame, bnd + B_COLUMNS * s, r);
+                box32(o, o + BX_BOX32);
+                b[BV_U0] = MIN(b[BV_U0], o[BV_U0]); b[BV_U1] = MAX(b[BV_U1], o[BV_U1]);
+                b[BV_V0] = MIN(b[BV_V0], o[BV_V0]); b[BV_V1] = MAX(b[BV_V1], o[BV_V1]);
             }
         }
         b[BV_FLOOR32] = floor32(b[BV_FLOOR]);

@@ -39,7 +39,7 @@ class Tree:
         """One bundle's node bounds around the balls (centre, ``radius``) of their shapes,
         and their least ``floor`` (None: -inf): the double cones around ``apex`` (lines
         through it) or the boxes on the two unit ``axes`` (2, 3) normal to parallel lines,
-        with each shape's own box too."""
+        with each shape's own box for parallel lines."""
         n = len(bnd)
         native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
         radius = np.ascontiguousarray(radius, np.float64)

@@ -356,6 +356,17 @@ void primary_shapes(const double *bnd, const uint8_t *ok, int64_t n, const doubl
         c[PC_BEHIND] = r < INFINITY && dist > r ? ((smax * smax - smin * smin) / 2.0 + 64.0 * uu * smax * smax) * dist
                                                 : NAN;
         c[PC_FLOOR32] = floor32(floor[s]);
+        /* the float test (cull.h primary_culled8), for |v| in [2**-20, 2**40]: the line
+         * distance's threshold widened by 8u|v| and (1 + 10u), the behind term by
+         * 7u mean2 |v| and (1 + 4u), both rounded up; NaN: no claim */
+        int fits = dist >= 0x1p-20 && dist <= 0x1p40;
+        double line = sqrt(c[PC_R2]) + 8 * U32 * dist, t2 = line * line * (1.0 + 10 * U32);
+        for (int k = 0; k < 3; k++)
+            c[PC_V32 + k] = (float)c[PC_V + k];
+        c[PC_T32] = fits && t2 <= 0x1p80 ? ceil32(t2) : NAN;
+        c[PC_M32] = (float)c[PC_MEAN2];
+        c[PC_B32] = fits && c[PC_BEHIND] == c[PC_BEHIND]
+                    ? ceil32((c[PC_BEHIND] + 7 * U32 * c[PC_MEAN2] * dist) * (1.0 + 4 * U32)) : NAN;
     }
 }
 

@@ -26,9 +26,12 @@ enum { CAM_ORIGIN = 0, CAM_TMIN = 3, CAM_TMAX = 4, CAM_Z = 5, CAM_ROT = 6, CAM_C
 enum { LT_KIND = 0, LT_LOC = 1, LT_DIR = 4, LT_INTENSITY = 7, LT_COLUMNS = 8 };
 enum { LIGHT_DIRECTIONAL = 1, LIGHT_POINT = 2 };
 /* Primary cull data per shape (double): centre minus camera, its squared length, the
- * squared cull radius with slack, the two terms of the behind test (bounds.h), and the
- * depth floor rounded down to a float (float lanes compare it with sq_dist). */
-enum { PC_V = 0, PC_VV = 3, PC_R2 = 4, PC_MEAN2 = 5, PC_BEHIND = 6, PC_FLOOR32 = 7, PC_COLUMNS = 8 };
+ * squared cull radius with slack, the two terms of the behind test (bounds.h), the depth
+ * floor rounded down to a float (float lanes compare it with sq_dist), and the float
+ * test's terms (cull.h primary_culled8: v rounded to floats, the widened threshold of the
+ * line distance, mean2 and the widened behind term; NaN where it must not cull). */
+enum { PC_V = 0, PC_VV = 3, PC_R2 = 4, PC_MEAN2 = 5, PC_BEHIND = 6, PC_FLOOR32 = 7, PC_V32 = 8, PC_T32 = 11,
+       PC_M32 = 12, PC_B32 = 13, PC_COLUMNS = 14 };
 /* Values per shape and per light in a pixel trace. */
 enum { TRACE_SHAPE_VALUES = 22, TRACE_LIGHT_VALUES = 12 };
 /* What a kernel reports per chunk (double): tests, tests that met NaN or infinity, shadow

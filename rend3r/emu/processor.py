@@ -291,6 +291,8 @@ def _plan(prog: _Program, frames: int | None) -> _Plan:
 def _apply(stream: _Stream, lo: int, hi: int, scene: Scene, entry: int) -> None:
     """Apply the writes of addresses [lo, hi) of ``stream`` (``entry``: the table code in
     force when the pass started)."""
+    if lo >= hi:  # e.g. an nf followed by er: nothing in between
+        return
     if stream.prog.options.clear_on_nr:
         i, j = stream.nr.searchsorted((lo, hi))
         if j > i:

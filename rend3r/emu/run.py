@@ -100,7 +100,7 @@ def run_program(
     result = RunResult()
     planned = plan(words, options, frames)
     at_once = frames_at_once(options, planned.execution.frames, memory)
-    one = replace(options, jobs=1)
+    one = replace(options, jobs=1) if at_once > 1 else options  # a thread per frame
     previous: list[Frame] = []
     pending: deque[tuple[int, int, Future]] = deque()  # frame number, bytes, its render
 
@@ -135,14 +135,17 @@ def run_program(
             oldest()
         pending.append((number, need, pool.submit(render, scene.copy(), one, number)))
 
-    with ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="rend3r-frame") as pool:
-        try:
-            planned.replay(on_nf)
-            while pending:
-                oldest()
-        finally:  # after an error or an interrupt, frames not started are dropped
-            for _, _, future in pending:
-                future.cancel()
+    if at_once == 1:
+        planned.replay(on_nf)
+    else:
+        with ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="rend3r-frame") as pool:
+            try:
+                planned.replay(on_nf)
+                while pending:
+                    oldest()
+            finally:  # after an error or an interrupt, frames not started are dropped
+                for _, _, future in pending:
+                    future.cancel()
     result.stats.instructions, result.stats.halt = planned.execution.instructions, planned.execution.halt
     result.stats.at_once, result.stats.seconds = at_once, perf_counter() - start
     return result

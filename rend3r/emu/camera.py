@@ -6,7 +6,7 @@ Both return :class:`Rays` in working precision, one ray per pixel in row-major o
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 from functools import cached_property, lru_cache
 
@@ -60,10 +60,11 @@ _RAY_PROPS = ("xloc", "yloc", "zloc", "rrot", "irot", "jrot", "krot", "nclip", "
 
 def camera_rays(scene: Scene, options: EmuOptions, arith: Arith) -> Rays:
     """The primary rays of the frame, by the camera model the options select. The same
-    camera gives the same rays, so the last few are kept for the frames and runs after
-    (their arrays are read-only)."""
+    camera gives the same rays, so the last few cameras' axes and terms are kept for the
+    frames and runs after (read-only arrays); each call gets its own Rays, so a frame's
+    per-pixel ``direction`` goes with it."""
     bits = tuple(scene.camera_bits(n) for n in _RAY_PROPS)
-    return _rays(bits, options.camera, options.width, options.height, arith)
+    return replace(_rays(bits, options.camera, options.width, options.height, arith))
 
 
 @lru_cache(maxsize=8)
@@ -75,8 +76,9 @@ def _rays(bits: tuple[int, ...], model: str, width: int, height: int, arith: Ari
         rays = _device_rays(origin, width, height, arith)
     else:
         rays = _spec_rays(cam, origin, width, height, arith)
-    for a in (rays.xs, rays.ys):
-        a.flags.writeable = False
+    for a in (rays.xs, rays.ys, rays.z, rays.tmin, rays.tmax, *rays.origin, *(rays.rotation or ())):
+        if isinstance(a, np.ndarray):
+            a.flags.writeable = False
     return rays
 
 

@@ -98,7 +98,7 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
         if fr.jobs > 1 and len(fr.sf) * PIXELS_PER_SHAPE <= n_pix:  # a band per thread at least
             rows = min(rows, -(-h // fr.jobs))
         bands = [(row0, min(h, row0 + rows)) for row0 in range(0, h, rows)]
-        extent = _extent(fr, 0, h)  # a grid camera's bands share one set of primary bounds
+        extent = _extent(fr)  # a grid camera's bands share one set of primary bounds
         primary = _primary_tree(fr, *extent) if extent is not None else None
         if len(bands) == 1:
             work = [(*bands[0], fr, None)]
@@ -284,7 +284,7 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
                        native.ptr(fr.xs, dtype, (w,)), native.ptr(fr.ys, dtype, (options.height,)),
                        int(fr.rotated), int(lit), w, row0, native.row_magic(w))
     band.npix = n_pix
-    if primary is None:  # a rotated camera: directions per pixel, kept for the nearest-hit pass
+    if primary is None:  # a rotated camera (or not finite): directions per pixel, kept for the nearest-hit pass
         a["dirs"] = np.empty((n_pix, 4), dtype)
         band.dirs = address(a["dirs"])
         parts = _run(fr.jobs, n_pix, fr.kernel("directions"), band, np.array([0.0, np.inf, 0.0]))
@@ -314,12 +314,12 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
 _Primary = tuple[bvh.Bounds, np.ndarray, np.ndarray]
 
 
-def _extent(fr: _Frame, row0: int, row1: int) -> tuple[float, float] | None:
-    """The shortest and longest primary direction of rows row0..row1 for a camera whose
+def _extent(fr: _Frame) -> tuple[float, float] | None:
+    """The shortest and longest primary direction of the frame for a camera whose
     directions are (x[col], y[row], z), all finite and z not zero; None for other cameras
-    (their directions are measured as the kernels compute them)."""
+    (each band measures its directions as the kernels compute them)."""
     z = float(fr.cam[native.CAM_Z])
-    xs, ys = fr.xs.astype(np.float64), fr.ys[row0:row1].astype(np.float64)
+    xs, ys = fr.xs.astype(np.float64), fr.ys.astype(np.float64)
     if fr.rotated or not (z != 0 and np.isfinite(z) and np.isfinite(xs).all() and np.isfinite(ys).all()):
         return None
     return (float(np.sqrt(np.min(xs**2) + np.min(ys**2) + z * z)),

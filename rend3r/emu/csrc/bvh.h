@@ -53,9 +53,8 @@ static inline i64x4 cone_missed4(const double *b, f64x4 w0, f64x4 w1, f64x4 w2, 
  * below u|w|. NaN never lies outside. */
 static inline i32x8 cone_missed8(const double *b, f32x8 w0, f32x8 w1, f32x8 w2, f32x8 ww)
 {
-    float a0 = (float)b[BV_AXIS32], a1 = (float)b[BV_AXIS32 + 1], a2 = (float)b[BV_AXIS32 + 2];
-    f32x8 c0 = w1 * a2 - w2 * a1, c1 = w2 * a0 - w0 * a2, c2 = w0 * a1 - w1 * a0;
-    return c0 * c0 + c1 * c1 + c2 * c2 > ww * (float)b[BV_SIN2_32];
+    return cross2_8((float)b[BV_AXIS32], (float)b[BV_AXIS32 + 1], (float)b[BV_AXIS32 + 2], w0, w1, w2)
+           > ww * (float)b[BV_SIN2_32];
 }
 
 /* flat_missed4 for eight lanes in float: u and v rounded to floats, the box b32 (u0, u1,

@@ -52,9 +52,8 @@ INLINE i64x4 primary_cull4(const double *pc, f64x4 d0, f64x4 d1, f64x4 d2, f64x4
 static inline i32x8 primary_culled8(const double *pc, f32x8 d0, f32x8 d1, f32x8 d2, f32x8 ww, f32x8 len)
 {
     float v0 = (float)pc[PC_V32], v1 = (float)pc[PC_V32 + 1], v2 = (float)pc[PC_V32 + 2];
-    f32x8 c0 = v1 * d2 - v2 * d1, c1 = v2 * d0 - v0 * d2, c2 = v0 * d1 - v1 * d0;
     f32x8 vd = v0 * d0 + v1 * d1 + v2 * d2;
-    i32x8 off = c0 * c0 + c1 * c1 + c2 * c2 > ww * (float)pc[PC_T32];
+    i32x8 off = cross2_8(v0, v1, v2, d0, d1, d2) > ww * (float)pc[PC_T32];
     return off | (-(float)pc[PC_M32] * vd - len * (float)pc[PC_B32] > 0x1.000004p-6f);
 }
 

@@ -51,6 +51,14 @@ INLINE double least4(f64x4 x)
     return x[0];
 }
 
+/* |a x w|^2 for one vector a and eight vectors w, in float (products and sums rounded in
+ * this order; bvh.h cone_missed8 and cull.h primary_culled8 bound its error). */
+INLINE f32x8 cross2_8(float a0, float a1, float a2, f32x8 w0, f32x8 w1, f32x8 w2)
+{
+    f32x8 c0 = w1 * a2 - w2 * a1, c1 = w2 * a0 - w0 * a2, c2 = w0 * a1 - w1 * a0;
+    return c0 * c0 + c1 * c1 + c2 * c2;
+}
+
 /* n consecutive doubles (n <= 4; the last repeated past n), and back. */
 INLINE f64x4 load4(const double *a, int n)
 {

@@ -17,6 +17,18 @@
 #include "kernels.h"
 
 #define BOUND_SLACK 1e-9
+
+/* fmin and fmax (the other number when one is NaN) inline: without -ffinite-math-only
+ * they are library calls, a sizeable part of the per-shape passes. */
+static inline double min_num(double a, double b)
+{
+    return a <= b || b != b ? a : b;
+}
+
+static inline double max_num(double a, double b)
+{
+    return a >= b || b != b ? a : b;
+}
 /* The largest effective unit roundoff (u plus an underflow's absolute error over the
  * squared direction length in normal space, tiny / min(1, |D|^2)) the bounds are claimed
  * for: 2**-6, where the first-order error terms they sum still dominate. For float16
@@ -40,7 +52,7 @@ static inline double cull_radius(double smin, double smax, double dist, double d
                                  double limit)
 {
     double dhat = smin * dmin;  /* |D| in normal space, at least */
-    double uu = u + tiny / fmin(1.0, dhat * dhat);
+    double uu = u + tiny / min_num(1.0, dhat * dhat);
     if (!(uu <= MAX_UU))
         return INFINITY;
     double mm = smax * dist;
@@ -64,7 +76,7 @@ static inline int misses(const double *b, double r, double o0, double o1, double
     if (!(dist > r))
         return 0;
     double smin = b[B_SMIN], smax = b[B_SMAX], dlen = sqrt(dd);
-    double uu = u + tiny / fmin(1.0, (smin * dlen) * (smin * dlen));
+    double uu = u + tiny / min_num(1.0, (smin * dlen) * (smin * dlen));
     double mean2 = (smax * smax + smin * smin) / 2.0, spread2 = (smax * smax - smin * smin) / 2.0;
     double ahead = -vd / dlen;  /* (origin - centre) . d / |d| */
     return dlen * (mean2 * ahead - (spread2 + 64.0 * uu * smax * smax) * dist) > 0.015625;  /* behind */
@@ -102,7 +114,7 @@ static inline double depth_floor(double smin, double smax, double dist, double d
                                  double tiny)
 {
     double dlo = smin * dmin;
-    double uu = u + tiny / fmin(1.0, fmin(dlo * dlo, dmin * dmin));
+    double uu = u + tiny / min_num(1.0, min_num(dlo * dlo, dmin * dmin));
     if (!(uu <= MAX_UU))
         return 0.0;
     double e = 32.0 * uu * (1.0 + smax / smin);  /* transform error, relative */
@@ -116,12 +128,12 @@ static inline double depth_floor(double smin, double smax, double dist, double d
     double up2 = (1.0 + uu) * (1.0 + uu), down2 = (1.0 - uu) * (1.0 - uu);  /* products, not pow(): the */
     double alpha = up2 * up2, beta = down2 * down2, ac = 2.0 * (1.0 - 4.0 * uu) * c_lo;  /* slack covers their ulps */
     double d_lo = dlo * (1.0 - e);
-    double b_min = sqrt(fmax(0.0, ((1.0 - uu) * ac - tiny / (d_lo * d_lo)) / (1.0 + uu)));
+    double b_min = sqrt(max_num(0.0, ((1.0 - uu) * ac - tiny / (d_lo * d_lo)) / (1.0 + uu)));
     if (!(b_min > 0))
         return 0.0;
-    double g_min = b_min - sqrt(fmax(0.0, alpha * b_min * b_min - beta * ac));
-    double g_max = b_max - sqrt(fmax(0.0, alpha * b_max * b_max - beta * ac));
-    double t_lo = (1.0 - uu) * (1.0 - uu) * fmin(g_min, g_max) / a_hi / (smax * (1.0 + e));
+    double g_min = b_min - sqrt(max_num(0.0, alpha * b_min * b_min - beta * ac));
+    double g_max = b_max - sqrt(max_num(0.0, alpha * b_max * b_max - beta * ac));
+    double t_lo = (1.0 - uu) * (1.0 - uu) * min_num(g_min, g_max) / a_hi / (smax * (1.0 + e));
     if (!(t_lo >= 2.0 * sqrt(tiny) * dmax))
         return 0.0;
     double floor = beta * down2 * (1.0 - 4.0 * uu) * t_lo * t_lo * (1.0 - BOUND_SLACK);

@@ -175,38 +175,45 @@ static void node_add(double *b, int kind, const double *frame, const double *c, 
     }
 }
 
-/* The float next to w towards -infinity (down) or +infinity, w not NaN and not at that
- * end: its bits step away from zero on the side it moves to, towards zero on the other,
- * and a zero becomes the smallest subnormal of that sign (nextafterf, without a call). */
-static float step32(float w, int down)
+/* The bits of the float next to w (bits b, not NaN) towards -infinity (down) or
+ * +infinity, w not at that end: they step away from zero on the side w moves to, towards
+ * zero on the other, and a zero becomes the smallest subnormal of that sign (nextafterf,
+ * without a call). Integer selects: the rounding's direction is random from shape to
+ * shape, and mispredicted branches cost more than both candidates. */
+static inline uint32_t step32(uint32_t b, int down)
 {
+    uint32_t away = (b >> 31) == (uint32_t)down;  /* moving away from zero */
+    uint32_t next = away ? b + 1 : b - 1;
+    return (b & 0x7fffffffu) == 0 ? (down ? 0x80000001u : 1u) : next;
+}
+
+/* x rounded to a float, then to its neighbour towards -infinity (down) or +infinity when
+ * the rounding went the other way; as a double (NaN stays NaN). */
+static inline double round32(double x, int down)
+{
+    float w = (float)x;
     uint32_t b;
     memcpy(&b, &w, sizeof b);
-    if (w == 0)
-        b = down ? 0x80000001u : 1u;
-    else
-        b = (w > 0) != down ? b + 1 : b - 1;
-    memcpy(&w, &b, sizeof w);
-    return w;
+    uint32_t pick = (down ? (double)w > x : (double)w < x) ? step32(b, down) : b;
+    memcpy(&w, &pick, sizeof w);
+    return (double)w;
 }
 
 /* The largest float at most x, as a double (NaN stays NaN): a depth floor that float
  * lanes compare with their sq_dist stays a lower bound. */
-static double floor32(double x)
+static inline double floor32(double x)
 {
-    float w = (float)x;
-    return (double)w > x ? (double)step32(w, 1) : (double)w;
+    return round32(x, 1);
 }
 
 /* The least float at least x, as a double. */
-static double ceil32(double x)
+static inline double ceil32(double x)
 {
-    float w = (float)x;
-    return (double)w < x ? (double)step32(w, 0) : (double)w;
+    return round32(x, 0);
 }
 
 /* A box's bounds (u0, u1, v0, v1) rounded outwards to floats, at out. */
-static void box32(const double *b, double *out)
+static inline void box32(const double *b, double *out)
 {
     out[0] = floor32(b[BV_U0]); out[1] = ceil32(b[BV_U1]);
     out[2] = floor32(b[BV_V0]); out[3] = ceil32(b[BV_V1]);
@@ -347,7 +354,7 @@ void primary_shapes(const double *bnd, const uint8_t *ok, int64_t n, const doubl
         double vv = v0 * v0 + v1 * v1 + v2 * v2, dist = sqrt(vv);
         int bounded = ok[s] && finite;
         double r = bounded ? cull_radius(smin, smax, dist, dmin, u, tiny, limit) : INFINITY;
-        double uu = u + tiny / fmin(1.0, (smin * dmin) * (smin * dmin));
+        double uu = u + tiny / min_num(1.0, (smin * dmin) * (smin * dmin));
         radius[s] = r;
         floor[s] = bounded ? depth_floor(smin, smax, dist, dmin, dmax, u, tiny) : 0.0;
         c[PC_V] = v0; c[PC_V + 1] = v1; c[PC_V + 2] = v2; c[PC_VV] = vv;
@@ -394,7 +401,7 @@ void shadow_shapes(const double *bnd, const uint8_t *ok, int64_t n, const double
         radius[s] = r;
         if (unit == NULL)
             continue;
-        double uu = u + tiny / fmin(1.0, (smin * l_len) * (smin * l_len)), *bh = behind + 3 * s;
+        double uu = u + tiny / min_num(1.0, (smin * l_len) * (smin * l_len)), *bh = behind + 3 * s;
         int bounded = r < INFINITY;
         bh[0] = bounded ? c0 * unit[0] + c1 * unit[1] + c2 * unit[2] : NAN;
         bh[1] = bounded ? (smax * smax + smin * smin) / 2.0 : NAN;

@@ -33,8 +33,8 @@ def primary(table: np.ndarray, ok: np.ndarray, apex: np.ndarray, dmin: float, dm
     apex = np.ascontiguousarray(apex, np.float64)
     native.ptr(apex, np.float64, (3,))
     radius, floor, pc = np.empty(n), np.empty(n), np.empty((n, native.PC_COLUMNS))
-    lib = native.library()
-    threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: lib.primary_shapes(
+    kernel = native.shape_pass("primary_shapes")
+    threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: kernel(
         address(table[a:]), address(flags[a:]), b - a, address(apex), dmin, dmax, u, tiny, overflow,
         address(radius[a:]), address(floor[a:]), address(pc[a:])))
     return radius, floor, pc
@@ -59,8 +59,8 @@ def shadow(table: np.ndarray, ok: np.ndarray, lo: np.ndarray, hi: np.ndarray, dm
         unit = np.ascontiguousarray(unit, np.float64)
         native.ptr(unit, np.float64, (3,))
     radius, behind = np.empty(n), None if unit is None else np.empty((n, 3))
-    lib = native.library()
-    threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: lib.shadow_shapes(
+    kernel = native.shape_pass("shadow_shapes")
+    threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: kernel(
         address(table[a:]), address(flags[a:]), b - a, address(mid), half, magnitude, dmin, chord, u, tiny,
         overflow, None if unit is None else address(unit), length, address(radius[a:]),
         None if behind is None else address(behind[a:])))

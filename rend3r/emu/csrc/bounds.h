@@ -15,20 +15,26 @@
 #include <math.h>
 
 #include "kernels.h"
+#include "simd.h"
 
 #define BOUND_SLACK 1e-9
 
-/* fmin and fmax (the other number when one is NaN) inline: without -ffinite-math-only
- * they are library calls, a sizeable part of the per-shape passes. */
+/* fmin and fmax (the other number when one is NaN), inline: without -ffinite-math-only
+ * they are library calls. */
 static inline double min_num(double a, double b)
 {
     return a <= b || b != b ? a : b;
 }
 
-static inline double max_num(double a, double b)
-{
-    return a >= b || b != b ? a : b;
-}
+/* Four lanes at a time, for the per-shape passes (kernels.c primary_shapes and
+ * shadow_shapes compute four shapes at once: their square roots and divisions are
+ * independent from shape to shape). Lane operations are the scalar IEEE operations. */
+INLINE f64x4 splat4(double x) { return (f64x4){x, x, x, x}; }
+INLINE f64x4 sel4(i64x4 m, f64x4 a, f64x4 b) { return (f64x4)SEL_BITS(m, (i64x4)a, (i64x4)b); }
+INLINE f64x4 min_num4(f64x4 a, f64x4 b) { return sel4((a <= b) | (b != b), a, b); }
+INLINE f64x4 max_num4(f64x4 a, f64x4 b) { return sel4((a >= b) | (b != b), a, b); }
+INLINE i64x4 finite4(f64x4 x) { return (x == x) & (x < INFINITY) & (x > -INFINITY); }
+
 /* The largest effective unit roundoff (u plus an underflow's absolute error over the
  * squared direction length in normal space, tiny / min(1, |D|^2)) the bounds are claimed
  * for: 2**-6, where the first-order error terms they sum still dominate. For float16
@@ -47,20 +53,17 @@ static inline double product_limit(double overflow, double u)
 }
 
 /* dist bounds the distance from the rays' origins to the centre, dmin the rays' direction
- * lengths from below, limit is product_limit(); INFINITY: no bound. */
-static inline double cull_radius(double smin, double smax, double dist, double dmin, double u, double tiny,
-                                 double limit)
+ * lengths from below, limit is product_limit(); INFINITY: no bound. Four shapes. */
+INLINE f64x4 cull_radius4(f64x4 smin, f64x4 smax, f64x4 dist, double dmin, double u, double tiny, double limit)
 {
-    double dhat = smin * dmin;  /* |D| in normal space, at least */
-    double uu = u + tiny / min_num(1.0, dhat * dhat);
-    if (!(uu <= MAX_UU))
-        return INFINITY;
-    double mm = smax * dist;
-    double cap = sqrt(1.0 + limit / (dhat * dhat));  /* a larger |S| overflows a2*c2 */
-    mm = mm < cap ? mm : cap;
-    double h = sqrt(1.0 + 24.0 * uu * (1.0 + mm * mm)) + 16.0 * uu * mm * (1.0 + smax / smin);
-    double r = h / smin * (1.0 + BOUND_SLACK) + BOUND_SLACK;
-    return isfinite(r) ? r : INFINITY;
+    f64x4 dhat = smin * dmin;  /* |D| in normal space, at least */
+    f64x4 uu = u + tiny / min_num4(splat4(1.0), dhat * dhat);
+    f64x4 mm = smax * dist;
+    f64x4 cap = sqrt4(1.0 + limit / (dhat * dhat));  /* a larger |S| overflows a2*c2 */
+    mm = sel4(mm < cap, mm, cap);
+    f64x4 h = sqrt4(1.0 + 24.0 * uu * (1.0 + mm * mm)) + 16.0 * uu * mm * (1.0 + smax / smin);
+    f64x4 r = h / smin * (1.0 + BOUND_SLACK) + BOUND_SLACK;
+    return sel4((uu <= MAX_UU) & finite4(r), r, splat4(INFINITY));
 }
 
 static inline int misses(const double *b, double r, double o0, double o1, double o2, double d0, double d1,
@@ -109,35 +112,27 @@ static inline int primary_cull(const double *pc, Ray *ray)
     return -pc[PC_MEAN2] * vd - ray->len * pc[PC_BEHIND] > 0.015625;
 }
 
-/* dist: from the apex to the centre; directions between dmin and dmax long; 0: no claim. */
-static inline double depth_floor(double smin, double smax, double dist, double dmin, double dmax, double u,
-                                 double tiny)
+/* dist: from the apex to the centre; directions between dmin and dmax long; 0: no claim.
+ * Four shapes. */
+INLINE f64x4 depth_floor4(f64x4 smin, f64x4 smax, f64x4 dist, double dmin, double dmax, double u, double tiny)
 {
-    double dlo = smin * dmin;
-    double uu = u + tiny / min_num(1.0, min_num(dlo * dlo, dmin * dmin));
-    if (!(uu <= MAX_UU))
-        return 0.0;
-    double e = 32.0 * uu * (1.0 + smax / smin);  /* transform error, relative */
-    if (!(e < 0.25))
-        return 0.0;
-    double s_lo = smin * dist * (1.0 - BOUND_SLACK) * (1.0 - e), s_hi = smax * dist * (1.0 + BOUND_SLACK) * (1.0 + e);
-    double b_max = 2.0 * s_hi * (1.0 + 4.0 * uu), a_hi = 2.0 * (1.0 + 4.0 * uu);
-    double c_lo = 2.0 * (s_lo * s_lo - 1.0) - 8.0 * uu * (s_hi * s_hi + 1.0);
-    if (!(c_lo > 0))
-        return 0.0;
-    double up2 = (1.0 + uu) * (1.0 + uu), down2 = (1.0 - uu) * (1.0 - uu);  /* products, not pow(): the */
-    double alpha = up2 * up2, beta = down2 * down2, ac = 2.0 * (1.0 - 4.0 * uu) * c_lo;  /* slack covers their ulps */
-    double d_lo = dlo * (1.0 - e);
-    double b_min = sqrt(max_num(0.0, ((1.0 - uu) * ac - tiny / (d_lo * d_lo)) / (1.0 + uu)));
-    if (!(b_min > 0))
-        return 0.0;
-    double g_min = b_min - sqrt(max_num(0.0, alpha * b_min * b_min - beta * ac));
-    double g_max = b_max - sqrt(max_num(0.0, alpha * b_max * b_max - beta * ac));
-    double t_lo = (1.0 - uu) * (1.0 - uu) * min_num(g_min, g_max) / a_hi / (smax * (1.0 + e));
-    if (!(t_lo >= 2.0 * sqrt(tiny) * dmax))
-        return 0.0;
-    double floor = beta * down2 * (1.0 - 4.0 * uu) * t_lo * t_lo * (1.0 - BOUND_SLACK);
-    return isfinite(floor) ? floor : 0.0;
+    const f64x4 zero = splat4(0.0);
+    f64x4 dlo = smin * dmin;
+    f64x4 uu = u + tiny / min_num4(splat4(1.0), min_num4(dlo * dlo, splat4(dmin * dmin)));
+    f64x4 e = 32.0 * uu * (1.0 + smax / smin);  /* transform error, relative */
+    f64x4 s_lo = smin * dist * (1.0 - BOUND_SLACK) * (1.0 - e), s_hi = smax * dist * (1.0 + BOUND_SLACK) * (1.0 + e);
+    f64x4 b_max = 2.0 * s_hi * (1.0 + 4.0 * uu), a_hi = 2.0 * (1.0 + 4.0 * uu);
+    f64x4 c_lo = 2.0 * (s_lo * s_lo - 1.0) - 8.0 * uu * (s_hi * s_hi + 1.0);
+    f64x4 up2 = (1.0 + uu) * (1.0 + uu), down2 = (1.0 - uu) * (1.0 - uu);  /* products, not pow(): the */
+    f64x4 alpha = up2 * up2, beta = down2 * down2, ac = 2.0 * (1.0 - 4.0 * uu) * c_lo;  /* slack covers their ulps */
+    f64x4 d_lo = dlo * (1.0 - e);
+    f64x4 b_min = sqrt4(max_num4(zero, ((1.0 - uu) * ac - tiny / (d_lo * d_lo)) / (1.0 + uu)));
+    f64x4 g_min = b_min - sqrt4(max_num4(zero, alpha * b_min * b_min - beta * ac));
+    f64x4 g_max = b_max - sqrt4(max_num4(zero, alpha * b_max * b_max - beta * ac));
+    f64x4 t_lo = (1.0 - uu) * (1.0 - uu) * min_num4(g_min, g_max) / a_hi / (smax * (1.0 + e));
+    f64x4 floor = beta * down2 * (1.0 - 4.0 * uu) * t_lo * t_lo * (1.0 - BOUND_SLACK);
+    i64x4 ok = (uu <= MAX_UU) & (e < 0.25) & (c_lo > 0) & (b_min > 0) & (t_lo >= 2.0 * sqrt(tiny) * dmax);
+    return sel4(ok & finite4(floor), floor, zero);
 }
 
 #endif

@@ -15,14 +15,6 @@
 #include "kernels.h"
 #include "simd.h"
 
-INLINE f64x4 sqrt4(f64x4 x)
-{
-    f64x4 r;
-    for (int i = 0; i < 4; i++)
-        r[i] = sqrt(x[i]);
-    return r;
-}
-
 /* Off the line: |v|^2 - (v.d)^2/|d|^2 > r^2, tested times |d|^2 (no division). */
 INLINE i64x4 primary_off4(const double *pc, f64x4 d0, f64x4 d1, f64x4 d2, f64x4 dd)
 {

@@ -338,76 +338,20 @@ void bvh_keys(const Bvh *t, const double *keys, double *out)
 
 /* ---- bounds per shape (rend3r/emu/bounds.py) ---- */
 
-/* The primary rays' bounds of shapes 0..n (bounds.py primary): per shape its cull radius
- * (INFINITY: none), depth floor (0: none) and cull data (PC_COLUMNS, primary_cull4 in
- * cull.h), for rays from apex with directions dmin..dmax long. A shape is bounded where
- * ok says so and apex is finite. */
-void primary_shapes(const double *bnd, const uint8_t *ok, int64_t n, const double *apex, double dmin, double dmax,
-                    double u, double tiny, double overflow, double *radius, double *floor, double *pc)
-{
-    double limit = product_limit(overflow, u);
-    int finite = isfinite(apex[0]) && isfinite(apex[1]) && isfinite(apex[2]);
-    for (int64_t s = 0; s < n; s++) {
-        const double *b = bnd + B_COLUMNS * s;
-        double *c = pc + PC_COLUMNS * s, smin = b[B_SMIN], smax = b[B_SMAX];
-        double v0 = b[B_CENTER] - apex[0], v1 = b[B_CENTER + 1] - apex[1], v2 = b[B_CENTER + 2] - apex[2];
-        double vv = v0 * v0 + v1 * v1 + v2 * v2, dist = sqrt(vv);
-        int bounded = ok[s] && finite;
-        double r = bounded ? cull_radius(smin, smax, dist, dmin, u, tiny, limit) : INFINITY;
-        double uu = u + tiny / min_num(1.0, (smin * dmin) * (smin * dmin));
-        radius[s] = r;
-        floor[s] = bounded ? depth_floor(smin, smax, dist, dmin, dmax, u, tiny) : 0.0;
-        c[PC_V] = v0; c[PC_V + 1] = v1; c[PC_V + 2] = v2; c[PC_VV] = vv;
-        c[PC_R2] = r < INFINITY ? r * r * (1.0 + BOUND_SLACK) + 1e-12 * vv : INFINITY;
-        c[PC_MEAN2] = (smax * smax + smin * smin) / 2.0;
-        c[PC_BEHIND] = r < INFINITY && dist > r ? ((smax * smax - smin * smin) / 2.0 + 64.0 * uu * smax * smax) * dist
-                                                : NAN;
-        c[PC_FLOOR32] = floor32(floor[s]);
-        /* the float test (cull.h primary_culled8), for |v| in [2**-20, 2**40]: the line
-         * distance's threshold widened by 8u|v| and (1 + 10u), the behind term by
-         * 7u mean2 |v| and (1 + 4u), both rounded up; NaN: no claim */
-        int fits = dist >= 0x1p-20 && dist <= 0x1p40;
-        double line = sqrt(c[PC_R2]) + 8 * U32 * dist, t2 = line * line * (1.0 + 10 * U32);
-        for (int k = 0; k < 3; k++)
-            c[PC_V32 + k] = (float)c[PC_V + k];
-        c[PC_T32] = fits && t2 <= 0x1p80 ? ceil32(t2) : NAN;
-        c[PC_M32] = (float)c[PC_MEAN2];
-        c[PC_B32] = fits && c[PC_BEHIND] == c[PC_BEHIND]
-                    ? ceil32((c[PC_BEHIND] + 7 * U32 * c[PC_MEAN2] * dist) * (1.0 + 4 * U32)) : NAN;
-    }
-}
+/* Four shapes' bound table columns (shape_bounds.inc). */
+typedef struct { f64x4 c[3], smin, smax; } Shapes4;
 
-/* A light's shadow-ray bounds of shapes 0..n (bounds.py shadow), for origins in the ball
- * (mid, half) whose coordinates are at most magnitude in size and directions at least
- * dmin long: per shape the cull radius, widened by far * (chord (1 + slack) + 1e-15)
- * where chord is not NaN (a point light: the turn of a rounded l off the line to the
- * light, far the distance to any origin) and by 1e-12 (|centre| + magnitude) for the
- * rounding of the origins; and where unit is not NULL (a directional light along unit,
- * l_len long) the behind terms (3 per shape: centre . unit, mean2, spread2 + 64 uu
- * smax^2; NaN without a radius). */
-void shadow_shapes(const double *bnd, const uint8_t *ok, int64_t n, const double *mid, double half,
-                   double magnitude, double dmin, double chord, double u, double tiny, double overflow,
-                   const double *unit, double l_len, double *radius, double *behind)
-{
-    double limit = product_limit(overflow, u);
-    for (int64_t s = 0; s < n; s++) {
-        const double *b = bnd + B_COLUMNS * s;
-        double c0 = b[B_CENTER], c1 = b[B_CENTER + 1], c2 = b[B_CENTER + 2], smin = b[B_SMIN], smax = b[B_SMAX];
-        double e0 = c0 - mid[0], e1 = c1 - mid[1], e2 = c2 - mid[2];
-        double far = sqrt(e0 * e0 + e1 * e1 + e2 * e2) * (1.0 + BOUND_SLACK) + half;
-        double slack = 1e-12 * (sqrt(c0 * c0 + c1 * c1 + c2 * c2) + magnitude);
-        double r = ok[s] ? cull_radius(smin, smax, far, dmin, u, tiny, limit) : INFINITY;
-        r += chord == chord ? far * (chord * (1.0 + BOUND_SLACK) + 1e-15) + slack : slack;
-        radius[s] = r;
-        if (unit == NULL)
-            continue;
-        double uu = u + tiny / min_num(1.0, (smin * l_len) * (smin * l_len)), *bh = behind + 3 * s;
-        int bounded = r < INFINITY;
-        bh[0] = bounded ? c0 * unit[0] + c1 * unit[1] + c2 * unit[2] : NAN;
-        bh[1] = bounded ? (smax * smax + smin * smin) / 2.0 : NAN;
-        bh[2] = bounded ? (smax * smax - smin * smin) / 2.0 + 64.0 * uu * smax * smax : NAN;
-    }
-}
+#define SB(name) name##_base
+#include "shape_bounds.inc"
+#undef SB
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#define SB(name) name##_avx2
+#include "shape_bounds.inc"
+#undef SB
+#pragma GCC pop_options
+#endif
 
 /* ---- the instruction processor (rend3r/emu/processor.py) ---- */
 

@@ -8,6 +8,7 @@
 #ifndef REND3R_SIMD_H
 #define REND3R_SIMD_H
 
+#include <math.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -39,6 +40,15 @@ typedef uint16_t u16x8 __attribute__((vector_size(16)));
 
 /* Lanes of mask m: from a where set, else from b (integer vectors of one type). */
 #define SEL_BITS(m, a, b) (((a) & (m)) | ((b) & ~(m)))
+
+/* Lane by lane square roots (the compiler makes one vector instruction of them). */
+INLINE f64x4 sqrt4(f64x4 x)
+{
+    f64x4 r;
+    for (int i = 0; i < 4; i++)
+        r[i] = sqrt(x[i]);
+    return r;
+}
 
 /* Lane by lane the lesser and the greater of two vectors of numbers (not NaN), and the
  * least lane of one. */

@@ -81,7 +81,9 @@ def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
     ``bounded`` with a finite centre; the others go to the list every ray tests."""
     n = len(bnd)
     native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
-    inside = np.asarray(bounded, bool) & np.isfinite(bnd[:, :3]).all(axis=1)
+    inside = np.asarray(bounded, bool)  # and a finite centre (column by column: .all(axis=1) costs ten times more)
+    for k in range(3):
+        inside = inside & np.isfinite(bnd[:, k])
     items = np.flatnonzero(inside).astype(np.int32)
     node = np.empty((max(1, 2 * len(items)), 2), np.int32)
     count = native.library().bvh_build(address(bnd), address(items), len(items), address(node))

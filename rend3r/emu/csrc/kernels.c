@@ -182,9 +182,9 @@ static void node_add(double *b, int kind, const double *frame, const double *c, 
  * shape, and mispredicted branches cost more than both candidates. */
 static inline uint32_t step32(uint32_t b, int down)
 {
-    uint32_t away = (b >> 31) == (uint32_t)down;  /* moving away from zero */
-    uint32_t next = away ? b + 1 : b - 1;
-    return (b & 0x7fffffffu) == 0 ? (down ? 0x80000001u : 1u) : next;
+    uint32_t away = -(uint32_t)((b >> 31) == (uint32_t)down);  /* all ones: moving away from zero */
+    uint32_t zero = -(uint32_t)((b & 0x7fffffffu) == 0), next = b - 1 + (away & 2u);
+    return ((down ? 0x80000001u : 1u) & zero) | (next & ~zero);
 }
 
 /* x rounded to a float, then to its neighbour towards -infinity (down) or +infinity when
@@ -194,7 +194,8 @@ static inline double round32(double x, int down)
     float w = (float)x;
     uint32_t b;
     memcpy(&b, &w, sizeof b);
-    uint32_t pick = (down ? (double)w > x : (double)w < x) ? step32(b, down) : b;
+    uint32_t step = -(uint32_t)(down ? (double)w > x : (double)w < x);  /* masks, not a branch */
+    uint32_t pick = (step32(b, down) & step) | (b & ~step);
     memcpy(&w, &pick, sizeof w);
     return (double)w;
 }

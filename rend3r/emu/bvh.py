@@ -51,7 +51,11 @@ class Tree:
         kind = native.BVH_CONE if apex is not None else native.BVH_FLAT
         frame = np.zeros(6)
         frame[: 3 if apex is not None else 6] = np.ravel(apex if apex is not None else axes)
-        item_box = np.empty((len(self.items), native.BX_COLUMNS)) if axes is not None else None
+        item_box = None
+        if axes is not None:  # each shape's own box, then the nodes' around them
+            item_box = np.empty((len(self.items), native.BX_COLUMNS))
+            native.shape_pass("flat_items")(address(self.items), len(self.items), address(bnd), address(radius),
+                                            address(frame), address(item_box))
         bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame, item_box)
         native.library().bvh_refit(bounds.struct(), address(bnd), address(radius),
                                    None if floor is None else address(floor), kind, address(frame),

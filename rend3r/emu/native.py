@@ -161,6 +161,7 @@ _PER_ISA = {  # name: (restype, argtypes); each exists once per instruction set 
                               c_void_p, c_void_p, c_void_p]),
     "shadow_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,
                              c_double, c_double, c_void_p, c_double, c_void_p, c_void_p]),
+    "flat_items": (None, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
 }
 
 

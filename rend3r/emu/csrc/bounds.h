@@ -34,6 +34,22 @@ INLINE f64x4 sel4(i64x4 m, f64x4 a, f64x4 b) { return (f64x4)SEL_BITS(m, (i64x4)
 INLINE f64x4 min_num4(f64x4 a, f64x4 b) { return sel4((a <= b) | (b != b), a, b); }
 INLINE f64x4 max_num4(f64x4 a, f64x4 b) { return sel4((a >= b) | (b != b), a, b); }
 INLINE i64x4 finite4(f64x4 x) { return (x == x) & (x < INFINITY) & (x > -INFINITY); }
+INLINE f64x4 abs4(f64x4 x) { return (f64x4)((i64x4)x & INT64_MAX); }
+
+/* x rounded to floats, then lane by lane to the neighbour towards -infinity (down) or
+ * +infinity where the rounding went the other way; as doubles (NaN stays NaN). The
+ * neighbour's bits step away from zero on the side the value moves to, towards zero on
+ * the other, and a zero becomes the smallest subnormal of that sign (nextafterf). */
+INLINE f64x4 round32_4(f64x4 x, int down)
+{
+    f32x4 w = __builtin_convertvector(x, f32x4);
+    f64x4 back = __builtin_convertvector(w, f64x4);
+    u32x4 step = (u32x4)__builtin_convertvector(down ? back > x : back < x, i32x4);
+    u32x4 bits = (u32x4)w, side = {0u, 0u, 0u, 0u};
+    u32x4 away = (u32x4)((bits >> 31) == side + (uint32_t)down), zero = (u32x4)((bits & 0x7fffffffu) == 0);
+    u32x4 next = bits - 1u + (away & 2u), stepped = ((down ? 0x80000001u : 1u) & zero) | (next & ~zero);
+    return __builtin_convertvector((f32x4)((stepped & step) | (bits & ~step)), f64x4);
+}
 
 /* The largest effective unit roundoff (u plus an underflow's absolute error over the
  * squared direction length in normal space, tiny / min(1, |D|^2)) the bounds are claimed

@@ -144,23 +144,12 @@ static void cone_union(double *a1, double *t1, const double *a2_, double t2)
     *t1 = t * (1.0 + 1e-12) + 1e-12;
 }
 
-/* A node's bound from its shapes' balls (centre c, cull radius r; an infinite or NaN
- * radius, or an apex inside the ball, bounds nothing). BVH_CONE: the double cone around
- * the apex (frame[0..3)) of the lines meeting the balls, half-angle asin(r / distance)
- * widened as cone_union widens; BVH_FLAT: the box of the discs the balls project to on the
- * unit axes frame[0..3), frame[3..6) normal to parallel lines, padded by 1e-9 of the
- * radius and 1e-12 of the centre's projection. */
-static void node_add(double *b, int kind, const double *frame, const double *c, double r)
+/* A shape's ball (centre c, cull radius r; an infinite or NaN radius, or an apex inside
+ * the ball, bounds nothing) added to a node's double cone around the apex (frame[0..3))
+ * of the lines meeting the balls: half-angle asin(r / distance), widened as cone_union
+ * widens. */
+static void cone_add(double *b, const double *frame, const double *c, double r)
 {
-    if (kind == BVH_FLAT) {
-        double u = c[0] * frame[0] + c[1] * frame[1] + c[2] * frame[2];
-        double v = c[0] * frame[3] + c[1] * frame[4] + c[2] * frame[5];
-        double ru = r < INFINITY ? r * (1.0 + 1e-9) + 1e-12 * fabs(u) : INFINITY;
-        double rv = r < INFINITY ? r * (1.0 + 1e-9) + 1e-12 * fabs(v) : INFINITY;
-        b[BV_U0] = MIN(b[BV_U0], u - ru); b[BV_U1] = MAX(b[BV_U1], u + ru);
-        b[BV_V0] = MIN(b[BV_V0], v - rv); b[BV_V1] = MAX(b[BV_V1], v + rv);
-        return;
-    }
     double e[3] = {c[0] - frame[0], c[1] - frame[1], c[2] - frame[2]};
     double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
     int ball = dist > r && r < INFINITY && dist < INFINITY;
@@ -223,14 +212,15 @@ static inline void box32(const double *b, double *out)
 /* A float's unit roundoff, 2**-24. */
 #define U32 5.9604644775390625e-08
 
-/* One bundle's node bounds (t->nodes x BV_COLUMNS into box; kind and frame as node_add
- * takes them) from the shapes' cull radii, and each node's least floor (NULL: -inf); for
- * parallel lines (BVH_FLAT) also each shape's own box into item_box (items x BX_COLUMNS,
- * in leaf order) unless it is NULL.
- * Children follow their parent, so nodes go last to first; a cone gets the squared sine
- * of its half-angle (inf from pi/2 on: every line) for the kernels' test. */
+/* One bundle's node bounds (t->nodes x BV_COLUMNS into box) from the shapes' cull radii,
+ * and each node's least floor (NULL: -inf): for BVH_CONE the double cones around the apex
+ * frame[0..3) (cone_add); for parallel lines (BVH_FLAT) the boxes holding the shapes' own
+ * boxes, item_box (items x BX_COLUMNS in leaf order, from flat_items; radius and frame
+ * are not read). Children follow their parent, so nodes go last to first; a cone gets
+ * the squared sine of its half-angle (inf from pi/2 on: every line) for the kernels' test,
+ * a box its bounds rounded outwards to floats. */
 void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const double *floor, int32_t kind,
-               const double *frame, double *box, double *item_box)
+               const double *frame, double *box, const double *item_box)
 {
     for (int64_t at = t->nodes - 1; at >= 0; at--) {
         double *b = box + BV_COLUMNS * at;
@@ -258,17 +248,12 @@ void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const doub
         } else {
             for (int32_t i = first; i < first + count; i++) {
                 int64_t s = t->items[i];
-                double r = radius[s] == radius[s] ? radius[s] : INFINITY;
                 b[BV_FLOOR] = MIN(b[BV_FLOOR], floor != NULL ? floor[s] : -INFINITY);
-                if (item_box == NULL) {
-                    node_add(b, kind, frame, bnd + B_COLUMNS * s, r);
+                if (kind == BVH_CONE) {
+                    cone_add(b, frame, bnd + B_COLUMNS * s, radius[s] == radius[s] ? radius[s] : INFINITY);
                     continue;
                 }
-                double *o = item_box + BX_COLUMNS * (int64_t)i;  /* the shape's own box, then the leaf's */
-                o[BV_U0] = o[BV_V0] = INFINITY;
-                o[BV_U1] = o[BV_V1] = -INFINITY;
-                node_add(o, kind, frame, bnd + B_COLUMNS * s, r);
-                box32(o, o + BX_BOX32);
+                const double *o = item_box + BX_COLUMNS * (int64_t)i;  /* the shape's own box (flat_items) */
                 b[BV_U0] = MIN(b[BV_U0], o[BV_U0]); b[BV_U1] = MAX(b[BV_U1], o[BV_U1]);
                 b[BV_V0] = MIN(b[BV_V0], o[BV_V0]); b[BV_V1] = MAX(b[BV_V1], o[BV_V1]);
             }

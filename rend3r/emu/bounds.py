@@ -42,13 +42,14 @@ def primary(table: np.ndarray, ok: np.ndarray, apex: np.ndarray, dmin: float, dm
 
 def shadow(table: np.ndarray, ok: np.ndarray, lo: np.ndarray, hi: np.ndarray, dmin: float, u: float, tiny: float,
            overflow: float, *, chord: float = np.nan, unit: np.ndarray | None = None, length: float = 0.0,
-           jobs: int = 1) -> tuple[np.ndarray, np.ndarray | None]:
+           jobs: int = 1) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
     """Per shape, the cull radius of shadow rays from origins in the box ``lo``..``hi``
     with directions at least ``dmin`` long, widened by the origins' rounding and, for a
     point light, by ``chord`` (the largest turn of a rounded l off the line to the light);
     for a directional light along the unit vector ``unit`` (|l| = ``length``), also the
-    behind terms (n, 3) of the light pass's per-packet test (``csrc/kernels.h``
-    LightPass.behind), else None."""
+    behind terms and stop keys (n, 3 each) of the light pass's per-packet test
+    (``csrc/kernels.h`` LightPass.behind, ``csrc/shape_bounds.inc`` shadow_shapes), else
+    None and None."""
     n = len(table)
     table, flags = _inputs(table, ok)
     lo3, hi3 = [float(c) for c in lo], [float(c) for c in hi]  # 3-vectors: plain arithmetic
@@ -58,13 +59,14 @@ def shadow(table: np.ndarray, ok: np.ndarray, lo: np.ndarray, hi: np.ndarray, dm
     if unit is not None:
         unit = np.ascontiguousarray(unit, np.float64)
         native.ptr(unit, np.float64, (3,))
-    radius, behind = np.empty(n), None if unit is None else np.empty((n, 3))
+    radius = np.empty(n)
+    behind, keys = (None, None) if unit is None else (np.empty((n, 3)), np.empty((n, 3)))
     kernel = native.shape_pass("shadow_shapes")
     threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: kernel(
         address(table[a:]), address(flags[a:]), b - a, address(mid), half, magnitude, dmin, chord, u, tiny,
         overflow, None if unit is None else address(unit), length, address(radius[a:]),
-        None if behind is None else address(behind[a:])))
-    return radius, behind
+        None if behind is None else address(behind[a:]), None if keys is None else address(keys[a:])))
+    return radius, behind, keys
 
 
 def _inputs(table: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

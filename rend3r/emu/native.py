@@ -145,7 +145,6 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
                               c_void_p, c_void_p, c_void_p]),
 }
 _PLAIN = {
-    "behind_keys": (None, [c_void_p, c_void_p, c_int64, c_double, c_void_p]),
     "bvh_keys": (None, [POINTER(Bvh), c_void_p, c_void_p]),
     "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p]),
     "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_void_p, c_void_p, c_int32, c_void_p, c_void_p, c_void_p]),
@@ -160,7 +159,7 @@ _PER_ISA = {  # name: (restype, argtypes); each exists once per instruction set 
     "primary_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,
                               c_void_p, c_void_p, c_void_p]),
     "shadow_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,
-                             c_double, c_double, c_void_p, c_double, c_void_p, c_void_p]),
+                             c_double, c_double, c_void_p, c_double, c_void_p, c_void_p, c_void_p]),
     "flat_items": (None, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
 }
 

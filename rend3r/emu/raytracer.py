@@ -160,7 +160,7 @@ def _shape_tables(scene: Scene, ar: Arith, fmt) -> tuple[np.ndarray, ...]:
     values = np.ascontiguousarray(table.values, np.uint16)
     index = np.ascontiguousarray(table.index, np.int64)
     rows = len(index)
-    sf = np.zeros((rows, native.SF_COLUMNS), native.dtype(ar))
+    sf = np.empty((rows, native.SF_COLUMNS), native.dtype(ar))  # shape_tables and origin_terms fill it
     si = np.empty((rows, native.SI_COLUMNS), np.int64)
     bnd = np.empty((rows, native.B_COLUMNS))
     bounded = np.empty(rows, np.uint8)
@@ -399,21 +399,19 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
         if not origins[8]:
             return _unbounded(fr, lp)
         bounded = fr.bounded & bool(np.isfinite(apex).all())
-        radius, _ = bounds.shadow(fr.bnd, bounded, lo, hi, float(origins[9]), *limits, chord=float(origins[7]),
-                                  jobs=fr.jobs)
+        radius, _, _ = bounds.shadow(fr.bnd, bounded, lo, hi, float(origins[9]), *limits, chord=float(origins[7]),
+                                     jobs=fr.jobs)
         return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex), np.zeros((0, 4), fr.dtype))
     length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
         return _unbounded(fr, lp)
-    radius, behind = bounds.shadow(fr.bnd, fr.bounded, lo, hi, length, *limits, unit=unit, length=length,
-                                   jobs=fr.jobs)
+    radius, behind, keys = bounds.shadow(fr.bnd, fr.bounded, lo, hi, length, *limits, unit=unit, length=length,
+                                         jobs=fr.jobs)
     along = np.empty((n, 4), fr.dtype)
     fr.kernel("shadow_directions")(byref(fr.shapes), address(light), address(along))
-    lib, keys = native.library(), np.empty((n, 3))
-    lib.behind_keys(address(behind), address(radius), n, length, address(keys))
     flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit))
     node_keys = np.empty((fr.tree.nodes, 3))
-    lib.bvh_keys(flat.struct(), address(keys), address(node_keys))
+    native.library().bvh_keys(flat.struct(), address(keys), address(node_keys))
     return _ShadowBounds(radius, flat, along, behind, node_keys, length, unit)
 
 

@@ -273,35 +273,7 @@ void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const doub
     }
 }
 
-/* A directional light's stop keys per shape (3 doubles: K0, K1, K2), from its behind
- * terms and cull radius; l_len: |l|.
- *
- * blocked() skips shape c for a packet when ahead = least - bh0 > 0, mid - spread > r and
- * l_len (bh1 ahead - bh2 (mid + spread)) > 1/64, mid being the distance from the packet's
- * centre to c's. The centre lies within spread of every origin, so its depth along l is
- * at least least - spread (mid >= ahead - spread), and a shape whose ball some lane's line
- * meets has its centre within r + spread of the packet's centre across l (mid <= ahead +
- * 2 spread + r; a shape no line meets is missed whatever the keys say). Hence least >= K2
- * + 2 spread, K2 = bh0 + r, gives the first two conditions, and least >= K0 + K1 spread,
- * K0 = bh0 + (b2 r + 1/(64 l_len)) / (bh1 - b2), K1 = 3 b2 / (bh1 - b2), the third (b2:
- * bh2 widened by 1e-8 for the rounding of mid; r likewise). A shape without a test gets
- * infinities. */
-void behind_keys(const double *behind, const double *radius, int64_t n, double l_len, double *out)
-{
-    for (int64_t s = 0; s < n; s++) {
-        const double *bh = behind + 3 * s;
-        double r = radius[s] * (1.0 + 1e-8), b2 = bh[2] * (1.0 + 1e-8), a = bh[1] - b2;
-        double pad = 1e-12 * (fabs(bh[0]) + r);
-        double key[3] = {bh[0] + (b2 * r + 0.015625 / l_len) / a + pad, 3.0 * b2 / a, bh[0] + r + pad};
-        int ok = bh[0] == bh[0] && a > 0 && r < INFINITY;
-        for (int c = 0; c < 3; c++)
-            ok &= key[c] == key[c] && key[c] < INFINITY;
-        for (int c = 0; c < 3; c++)
-            out[3 * s + c] = ok ? key[c] : INFINITY;
-    }
-}
-
-/* Per node of t, the largest of each of its shapes' stop keys (behind_keys; out: 3 per
+/* Per node of t, the largest of each of its shapes' stop keys (shadow_shapes; out: 3 per
  * node): a packet for which the keys' test holds has every shape below it behind every
  * origin (K1 multiplies spread >= 0, so the test only gets harder as keys grow). */
 void bvh_keys(const Bvh *t, const double *keys, double *out)

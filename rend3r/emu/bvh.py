@@ -39,7 +39,8 @@ class Tree:
         """One bundle's node bounds around the balls (centre, ``radius``) of their shapes,
         and their least ``floor`` (None: -inf): the double cones around ``apex`` (lines
         through it) or the boxes on the two unit ``axes`` (2, 3) normal to parallel lines,
-        with each shape's own box for parallel lines."""
+        with each shape's own box for parallel lines. Each shape's own bound is computed
+        first, four shapes at a time (csrc/shape_bounds.inc), then joined node by node."""
         n = len(bnd)
         native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
         radius = np.ascontiguousarray(radius, np.float64)
@@ -51,15 +52,13 @@ class Tree:
         kind = native.BVH_CONE if apex is not None else native.BVH_FLAT
         frame = np.zeros(6)
         frame[: 3 if apex is not None else 6] = np.ravel(apex if apex is not None else axes)
-        item_box = None
-        if axes is not None:  # each shape's own box, then the nodes' around them
-            item_box = np.empty((len(self.items), native.BX_COLUMNS))
-            native.shape_pass("flat_items")(address(self.items), len(self.items), address(bnd), address(radius),
-                                            address(frame), address(item_box))
-        bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame, item_box)
-        native.library().bvh_refit(bounds.struct(), address(bnd), address(radius),
-                                   None if floor is None else address(floor), kind, address(frame),
-                                   address(bounds.box), None if item_box is None else address(item_box))
+        # each shape's own cone (a scratch array) or box (kept: shadow packets test it), then the nodes'
+        own = np.empty((len(self.items), native.CI_COLUMNS if apex is not None else native.BX_COLUMNS))
+        native.shape_pass("cone_items" if apex is not None else "flat_items")(
+            address(self.items), len(self.items), address(bnd), address(radius), address(frame), address(own))
+        bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame, own if axes is not None else None)
+        native.library().bvh_refit(bounds.struct(), None if floor is None else address(floor), kind,
+                                   address(bounds.box), address(own))
         return bounds
 
 

@@ -39,6 +39,7 @@ PC_COLUMNS = 14
 BVH_CONE, BVH_FLAT = 0, 1  # a hierarchy's bounds around lines through one apex, or parallel lines
 BV_ANGLE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 4, 5, 11  # their columns (csrc/kernels.h)
 BX_COLUMNS = 8  # a shape's own box on the axes normal to parallel lines (and rounded to floats)
+CI_COLUMNS = 4  # a shape's own cone around an apex: unit axis, half-angle
 
 
 class Format(Structure):
@@ -147,7 +148,7 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
 _PLAIN = {
     "bvh_keys": (None, [POINTER(Bvh), c_void_p, c_void_p]),
     "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p]),
-    "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_void_p, c_void_p, c_int32, c_void_p, c_void_p, c_void_p]),
+    "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_int32, c_void_p, c_void_p]),
     "have_avx2": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
     "stream_scan": (None, [c_void_p, c_int64, c_int64, c_int32, c_int32, c_void_p, c_void_p, c_void_p, c_void_p,
@@ -161,6 +162,7 @@ _PER_ISA = {  # name: (restype, argtypes); each exists once per instruction set 
     "shadow_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,
                              c_double, c_double, c_void_p, c_double, c_void_p, c_void_p, c_void_p]),
     "flat_items": (None, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
+    "cone_items": (None, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
 }
 
 

@@ -144,26 +144,6 @@ static void cone_union(double *a1, double *t1, const double *a2_, double t2)
     *t1 = t * (1.0 + 1e-12) + 1e-12;
 }
 
-/* A shape's ball (centre c, cull radius r; an infinite or NaN radius, or an apex inside
- * the ball, bounds nothing) added to a node's double cone around the apex (frame[0..3))
- * of the lines meeting the balls: half-angle asin(r / distance), widened as cone_union
- * widens. */
-static void cone_add(double *b, const double *frame, const double *c, double r)
-{
-    double e[3] = {c[0] - frame[0], c[1] - frame[1], c[2] - frame[2]};
-    double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-    int ball = dist > r && r < INFINITY && dist < INFINITY;
-    double angle = ball ? asin(r / dist) * (1.0 + 1e-12) + 1e-12 : HALF_PI;
-    for (int k = 0; k < 3 && ball; k++)
-        e[k] /= dist;
-    if (b[BV_ANGLE] < 0) {
-        memcpy(b + BV_AXIS, e, sizeof e);
-        b[BV_ANGLE] = angle;
-    } else {
-        cone_union(b + BV_AXIS, &b[BV_ANGLE], e, angle);
-    }
-}
-
 /* The bits of the float next to w (bits b, not NaN) towards -infinity (down) or
  * +infinity, w not at that end: they step away from zero on the side w moves to, towards
  * zero on the other, and a zero becomes the smallest subnormal of that sign (nextafterf,
@@ -212,15 +192,14 @@ static inline void box32(const double *b, double *out)
 /* A float's unit roundoff, 2**-24. */
 #define U32 5.9604644775390625e-08
 
-/* One bundle's node bounds (t->nodes x BV_COLUMNS into box) from the shapes' cull radii,
- * and each node's least floor (NULL: -inf): for BVH_CONE the double cones around the apex
- * frame[0..3) (cone_add); for parallel lines (BVH_FLAT) the boxes holding the shapes' own
- * boxes, item_box (items x BX_COLUMNS in leaf order, from flat_items; radius and frame
- * are not read). Children follow their parent, so nodes go last to first; a cone gets
- * the squared sine of its half-angle (inf from pi/2 on: every line) for the kernels' test,
- * a box its bounds rounded outwards to floats. */
-void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const double *floor, int32_t kind,
-               const double *frame, double *box, const double *item_box)
+/* One bundle's node bounds (t->nodes x BV_COLUMNS into box) from its shapes' own bounds
+ * (items, in leaf order): for BVH_CONE the double cones around the apex holding the
+ * shapes' cones (CI_COLUMNS per item, from cone_items), for parallel lines (BVH_FLAT) the
+ * boxes holding the shapes' boxes (BX_COLUMNS per item, from flat_items); and each node's
+ * least floor (NULL: -inf). Children follow their parent, so nodes go last to first; a
+ * cone gets the squared sine of its half-angle (inf from pi/2 on: every line) for the
+ * kernels' test, a box its bounds rounded outwards to floats. */
+void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items)
 {
     for (int64_t at = t->nodes - 1; at >= 0; at--) {
         double *b = box + BV_COLUMNS * at;
@@ -249,11 +228,17 @@ void bvh_refit(const Bvh *t, const double *bnd, const double *radius, const doub
             for (int32_t i = first; i < first + count; i++) {
                 int64_t s = t->items[i];
                 b[BV_FLOOR] = MIN(b[BV_FLOOR], floor != NULL ? floor[s] : -INFINITY);
-                if (kind == BVH_CONE) {
-                    cone_add(b, frame, bnd + B_COLUMNS * s, radius[s] == radius[s] ? radius[s] : INFINITY);
+                if (kind == BVH_CONE) {  /* the shape's own cone (cone_items) */
+                    const double *o = items + CI_COLUMNS * (int64_t)i;
+                    if (b[BV_ANGLE] < 0) {
+                        memcpy(b + BV_AXIS, o, 3 * sizeof(double));
+                        b[BV_ANGLE] = o[CI_ANGLE];
+                    } else {
+                        cone_union(b + BV_AXIS, &b[BV_ANGLE], o, o[CI_ANGLE]);
+                    }
                     continue;
                 }
-                const double *o = item_box + BX_COLUMNS * (int64_t)i;  /* the shape's own box (flat_items) */
+                const double *o = items + BX_COLUMNS * (int64_t)i;  /* the shape's own box (flat_items) */
                 b[BV_U0] = MIN(b[BV_U0], o[BV_U0]); b[BV_U1] = MAX(b[BV_U1], o[BV_U1]);
                 b[BV_V0] = MIN(b[BV_V0], o[BV_V0]); b[BV_V1] = MAX(b[BV_V1], o[BV_V1]);
             }

@@ -76,6 +76,9 @@ enum { BV_AXIS = 0, BV_ANGLE = 3, BV_SIN2 = 4, BV_U0 = 0, BV_U1 = 1, BV_V0 = 2, 
  * boxes also come rounded outwards to floats (at BV_BOX32 of a node, BX_BOX32 of an item:
  * u0, u1, v0, v1; bvh.h flat_missed8). */
 enum { BX_BOX32 = 4, BX_COLUMNS = 8 };
+/* A shape's own cone for lines through one apex (unit axis, half-angle), per item in leaf
+ * order, while the nodes' cones are fitted (kernels.c bvh_refit). */
+enum { CI_ANGLE = 3, CI_COLUMNS = 4 };
 
 typedef struct {
     const int32_t *node;    /* per node: right child (inner) or first item (leaf), item count (0: inner);

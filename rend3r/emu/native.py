@@ -122,8 +122,10 @@ except ImportError:  # no compiled kernels: library() says so when one is first 
 
 def ptr(a: np.ndarray, dtype: type | np.dtype, shape: tuple[int | None, ...]) -> int:
     """The address of ``a`` after checking its dtype, C-contiguity and shape (None: any)."""
-    if a.dtype != np.dtype(dtype) or not a.flags.c_contiguous or a.ndim != len(shape) or any(
-            want is not None and have != want for have, want in zip(a.shape, shape)):
+    ok = a.dtype == dtype and a.flags.c_contiguous and a.ndim == len(shape)
+    for have, want in zip(a.shape, shape):  # a loop, not any(generator): this runs ~25 times a frame
+        ok = ok and (want is None or have == want)
+    if not ok:
         raise TypeError(f"kernel argument: expected {np.dtype(dtype)} {shape}, got {a.dtype} {a.shape}")
     return address(a)
 

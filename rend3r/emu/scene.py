@@ -10,6 +10,7 @@ with the property tables (never hard-coded numbers).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -17,6 +18,7 @@ from ..isa import Table, lookup
 from ..isa.tables import LIGHT_INDEX_LIMIT, PROP_LIMIT, SHAPE_INDEX_LIMIT
 
 
+@lru_cache(maxsize=256)
 def prop_index(table: Table, name: str) -> int:
     """Index of a property by name (KeyError if the table has no such property)."""
     prop = lookup(table, name)

@@ -36,10 +36,45 @@ INLINE f64x4 max_num4(f64x4 a, f64x4 b) { return sel4((a >= b) | (b != b), a, b)
 INLINE i64x4 finite4(f64x4 x) { return (x == x) & (x < INFINITY) & (x > -INFINITY); }
 INLINE f64x4 abs4(f64x4 x) { return (f64x4)((i64x4)x & INT64_MAX); }
 
-/* x rounded to floats, then lane by lane to the neighbour towards -infinity (down) or
- * +infinity where the rounding went the other way; as doubles (NaN stays NaN). The
- * neighbour's bits step away from zero on the side the value moves to, towards zero on
- * the other, and a zero becomes the smallest subnormal of that sign (nextafterf). */
+/* The bits of the float next to w (bits b, not NaN) towards -infinity (down) or
+ * +infinity, w not at that end: they step away from zero on the side w moves to, towards
+ * zero on the other, and a zero becomes the smallest subnormal of that sign (nextafterf,
+ * without a call). Integer selects: the rounding's direction is random from shape to
+ * shape, and mispredicted branches cost more than both candidates. */
+static inline uint32_t step32(uint32_t b, int down)
+{
+    uint32_t away = -(uint32_t)((b >> 31) == (uint32_t)down);  /* all ones: moving away from zero */
+    uint32_t zero = -(uint32_t)((b & 0x7fffffffu) == 0), next = b - 1 + (away & 2u);
+    return ((down ? 0x80000001u : 1u) & zero) | (next & ~zero);
+}
+
+/* x rounded to a float, then to its neighbour towards -infinity (down) or +infinity when
+ * the rounding went the other way; as a double (NaN stays NaN). */
+static inline double round32(double x, int down)
+{
+    float w = (float)x;
+    uint32_t b;
+    memcpy(&b, &w, sizeof b);
+    uint32_t step = -(uint32_t)(down ? (double)w > x : (double)w < x);  /* masks, not a branch */
+    uint32_t pick = (step32(b, down) & step) | (b & ~step);
+    memcpy(&w, &pick, sizeof w);
+    return (double)w;
+}
+
+/* The largest float at most x, as a double (NaN stays NaN): a depth floor that float
+ * lanes compare with their sq_dist stays a lower bound. */
+static inline double floor32(double x)
+{
+    return round32(x, 1);
+}
+
+/* The least float at least x, as a double. */
+static inline double ceil32(double x)
+{
+    return round32(x, 0);
+}
+
+/* round32 on four lanes. */
 INLINE f64x4 round32_4(f64x4 x, int down)
 {
     f32x4 w = __builtin_convertvector(x, f32x4);

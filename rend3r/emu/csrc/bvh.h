@@ -58,7 +58,7 @@ static inline i32x8 cone_missed8(const double *b, f32x8 w0, f32x8 w1, f32x8 w2, 
 }
 
 /* flat_missed4 for eight lanes in float: u and v rounded to floats, the box b32 (u0, u1,
- * v0, v1) rounded outwards (kernels.c box32). Rounding is monotonic, so u >= u0 gives
+ * v0, v1) rounded outwards (bounds.h round32). Rounding is monotonic, so u >= u0 gives
  * fl(u) >= fl(u0) >= b32[0], and likewise at the other sides: a lane inside the box is
  * never reported outside, whatever the magnitudes (overflow included). */
 static inline i32x8 flat_missed8(const double *b32, f32x8 u, f32x8 v)

@@ -144,44 +144,6 @@ static void cone_union(double *a1, double *t1, const double *a2_, double t2)
     *t1 = t * (1.0 + 1e-12) + 1e-12;
 }
 
-/* The bits of the float next to w (bits b, not NaN) towards -infinity (down) or
- * +infinity, w not at that end: they step away from zero on the side w moves to, towards
- * zero on the other, and a zero becomes the smallest subnormal of that sign (nextafterf,
- * without a call). Integer selects: the rounding's direction is random from shape to
- * shape, and mispredicted branches cost more than both candidates. */
-static inline uint32_t step32(uint32_t b, int down)
-{
-    uint32_t away = -(uint32_t)((b >> 31) == (uint32_t)down);  /* all ones: moving away from zero */
-    uint32_t zero = -(uint32_t)((b & 0x7fffffffu) == 0), next = b - 1 + (away & 2u);
-    return ((down ? 0x80000001u : 1u) & zero) | (next & ~zero);
-}
-
-/* x rounded to a float, then to its neighbour towards -infinity (down) or +infinity when
- * the rounding went the other way; as a double (NaN stays NaN). */
-static inline double round32(double x, int down)
-{
-    float w = (float)x;
-    uint32_t b;
-    memcpy(&b, &w, sizeof b);
-    uint32_t step = -(uint32_t)(down ? (double)w > x : (double)w < x);  /* masks, not a branch */
-    uint32_t pick = (step32(b, down) & step) | (b & ~step);
-    memcpy(&w, &pick, sizeof w);
-    return (double)w;
-}
-
-/* The largest float at most x, as a double (NaN stays NaN): a depth floor that float
- * lanes compare with their sq_dist stays a lower bound. */
-static inline double floor32(double x)
-{
-    return round32(x, 1);
-}
-
-/* The least float at least x, as a double. */
-static inline double ceil32(double x)
-{
-    return round32(x, 0);
-}
-
 /* A box's bounds (u0, u1, v0, v1) rounded outwards to floats, at out. */
 static inline void box32(const double *b, double *out)
 {

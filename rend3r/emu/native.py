@@ -98,7 +98,7 @@ class Pairs(Structure):
 class LightPass(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("band", POINTER(Band)), ("light", c_void_p), ("scale", c_double * 3),
                 ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
-                ("first", c_int32), ("last", c_int32), ("along", c_void_p), ("behind", c_void_p),
+                ("first", c_int32), ("last", c_int32), ("behind", c_void_p),
                 ("l_hat", c_double * 3), ("l_len", c_double), ("radius", c_void_p), ("tree", Bvh), ("keys", c_void_p)]
 
 
@@ -141,7 +141,6 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
     "origin_terms": (None, [POINTER(Shapes), c_void_p]),
     "shape_tables": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p,
                                c_void_p, c_void_p, POINTER(Format)]),
-    "shadow_directions": (None, [POINTER(Shapes), c_void_p, c_void_p]),
     "light_pass": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
     "shadow_origins": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
     "trace_pixel": (c_int64, [POINTER(Band), c_int32, c_int32, c_void_p, c_void_p, c_int64, c_int64, c_int64,

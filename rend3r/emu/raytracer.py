@@ -351,7 +351,7 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
     lp.first, lp.last = int(k == 0), int(k == len(fr.lights) - 1)
     if shadows:  # lp points into the arrays of sb: they live until the pass is done
         sb = _shadow_bounds(fr, lp, light, hits, n_pix)
-        lp.tree, lp.radius, lp.along = sb.bounds.struct(), address(sb.radius), address(sb.along)
+        lp.tree, lp.radius = sb.bounds.struct(), address(sb.radius)
         if sb.behind is not None:
             lp.behind, lp.keys = address(sb.behind), address(sb.keys)
             lp.l_len, lp.l_hat[:] = sb.l_len, sb.l_hat
@@ -376,7 +376,6 @@ class _ShadowBounds:
 
     radius: np.ndarray  # cull radius per shape
     bounds: bvh.Bounds  # the hierarchy's bounds for these rays
-    along: np.ndarray  # a directional light's l in normal space and a2, per shape
     behind: np.ndarray | None = None  # a directional light's behind terms per shape
     keys: np.ndarray | None = None  # ... and per node the largest stop keys below it
     l_len: float = 0.0  # ... and |l| and l / |l| in double
@@ -388,7 +387,6 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
     """Cull radii and node boxes for a light's shadow rays from the band's hit points; a
     directional light's also get the behind terms and stop keys, so a packet skips whole
     subtrees lying behind its origins."""
-    n = len(fr.sf)
     if not hits[native.OUT_HITS]:
         return _unbounded(fr, lp)
     lo, hi = hits[native.OUT_LO:native.OUT_LO + 3], hits[native.OUT_HI:native.OUT_HI + 3]
@@ -401,25 +399,23 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
         bounded = fr.bounded & bool(np.isfinite(apex).all())
         radius, _, _ = bounds.shadow(fr.bnd, bounded, lo, hi, float(origins[9]), *limits, chord=float(origins[7]),
                                      jobs=fr.jobs)
-        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex), np.zeros((0, 4), fr.dtype))
+        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex))
     length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
         return _unbounded(fr, lp)
     radius, behind, keys = bounds.shadow(fr.bnd, fr.bounded, lo, hi, length, *limits, unit=unit, length=length,
                                          jobs=fr.jobs)
-    along = np.empty((n, 4), fr.dtype)
-    fr.kernel("shadow_directions")(byref(fr.shapes), address(light), address(along))
     flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit))
     node_keys = np.empty((fr.tree.nodes, 3))
     native.library().bvh_keys(flat.struct(), address(keys), address(node_keys))
-    return _ShadowBounds(radius, flat, along, behind, node_keys, length, unit)
+    return _ShadowBounds(radius, flat, behind, node_keys, length, unit)
 
 
 def _unbounded(fr: _Frame, lp: native.LightPass) -> _ShadowBounds:
     """Bounds of infinite radii: every shadow ray tests every shape."""
     none = np.full(len(fr.sf), np.inf)
     everywhere = {"axes": np.eye(3)[:2]} if lp.parallel else {"apex": np.zeros(3)}
-    return _ShadowBounds(none, fr.tree.refit(fr.bnd, none, **everywhere), np.zeros((0, 4), fr.dtype))
+    return _ShadowBounds(none, fr.tree.refit(fr.bnd, none, **everywhere))
 
 
 def _unit(v: np.ndarray) -> tuple[float, np.ndarray]:

@@ -19,6 +19,7 @@ from rend3r.emu.frame import Frame
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.processor import execute
 from rend3r.emu.quirks import apply_quirks, quirk_names
+from rend3r.emu import reference
 from rend3r.emu.raytracer import render_frame
 from rend3r.emu.reference import render_reference
 from rend3r.emu.scene import Scene
@@ -219,6 +220,43 @@ def test_random_walls(g, k, size, distance, lights, rot, prec):
 def test_random_walls_in_other_formats(g, k, size, distance, lights, rot, prec):
     """Walls in any format: culled with each format's own bounds (overflowing tests miss)."""
     _wall(g, k, size, distance, lights, rot, prec)
+
+
+#: A directional light grazing a wall: travelling mostly along x or y, so that spheres
+#: shadow their neighbours.
+grazing = st.tuples(st.sampled_from([0, 1]), st.sampled_from([-1.0, 1.0]), st.floats(-0.4, 0.4),
+                    st.floats(-0.6, 0.2)).map(
+    lambda a: {"src": 1, **{n: float_to_bits(v) for n, v in zip(("xfor", "yfor", "zfor"),
+                                                                 (a[1], a[2], a[3]) if a[0] else (a[2], a[1], a[3]))},
+               "col": 0xFFFF, "int": float_to_bits(1.0)})
+
+
+@settings(max_examples=60, derandomize=True)
+@given(st.integers(2, 5), st.integers(1, 3), st.floats(0.3, 0.6), st.floats(2, 12), grazing,
+       st.tuples(*[st.floats(0.6, 1.6)] * 3), quaternion(0), precision)
+def test_neighbours_shadowing_each_other(g, k, fill, distance, lit, stretch, rot, prec):
+    """A directional light's packets of one receiver test only that receiver's casters
+    (csrc/casters.h): close walls of stretched, turned spheres under a grazing light, where
+    neighbours block shadow rays (counted in the reference), render as the reference does."""
+    cam = {"xloc": 0, "yloc": 0, "zloc": 0, "rot": (0, 0, 0, 0), "hfov": float_to_bits(0.4),
+           "vfov": float_to_bits(0.4), "nclip": 0, "fclip": 0}
+    shapes = [{"type": 1, "col": 0x0841 * (i + 1) & 0xFFFF, "rot": rot, "stretch": stretch, "special": None,
+               "aim": (0.5 + ((i % g) - (g - 1) / 2) / (g + 1), 0.5 + ((i // g % g) - (g - 1) / 2) / (g + 1),
+                       distance * (1 + 0.1 * (i // (g * g))), fill / (g + 1))} for i in range(g * g * k)]
+    options = EmuOptions(precision=prec[0], subnormals=prec[1], width=32, height=24)
+    blocked, plain = [], reference._blocked
+
+    def counted(*args):
+        out = plain(*args)
+        blocked.append(int(out.sum()))
+        return out
+
+    reference._blocked = counted
+    try:
+        check(program(cam, [lit], shapes, [], options), options)
+    finally:
+        reference._blocked = plain
+    event(f"shadowed points: {'none' if not sum(blocked) else 'some'}")
 
 
 @settings(max_examples=60, derandomize=True)

@@ -128,10 +128,9 @@ typedef struct {            /* one light over one band */
     double scale[3];        /* light channel / channel maximum */
     int32_t fixed;          /* the device's 13-bit intensity converter */
     int32_t shadows;        /* cast shadow rays (there are other shapes) */
-    int32_t parallel;       /* directional light: per-shape terms in along */
+    int32_t parallel;       /* directional light */
     int32_t first;          /* the band's first light: it sets the colour sums instead of adding */
     int32_t last;           /* the band's last light: its pass also finishes the pixels */
-    const void *along;      /* n x 4: l in normal space and a2, working (directional) */
     const double *behind;   /* n x 3 (directional): centre . l/|l|, and the behind test's mean2
                                and (spread2 + 64 uu smax^2), NaN where no test applies */
     double l_hat[3], l_len; /* a directional light's l/|l| and |l| */

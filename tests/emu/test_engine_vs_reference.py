@@ -4,7 +4,7 @@ shape, numpy): identical pixels, depth bits and provenance on random scenes.
 Scenes mix every shape type (and types that are off), rotations, scales, both cameras,
 directional and point lights, every precision (and other formats eEmM) with flushed and gradual underflow, the
 original board's profile, exact ties (duplicated shapes), and float16 operands that are
-infinite, NaN, subnormal, zero of either sign or the largest finite value. About 960
+infinite, NaN, subnormal, zero of either sign or the largest finite value. About 1,020
 scenes run in CI (fixed seed); ``benchmarks/fuzz_engine.py`` runs more.
 """
 

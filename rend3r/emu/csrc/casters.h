@@ -111,7 +111,8 @@ static void casters_fill(const LightPass *lp, int64_t s, Casters *e)
     while (top >= 0) {
         int32_t at = stack[top--];
         const double *key = lp->keys + 3 * at;
-        if (least >= MAX(key[0] + key[1] * spread, key[2] + 2.0 * spread) || box_beyond(t->box + BV_COLUMNS * at, u, v, reach))
+        if (least >= MAX(key[0] + key[1] * spread, key[2] + 2.0 * spread) ||
+            box_beyond(t->box + BV_COLUMNS * at, u, v, reach))
             continue;
         int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
         if (count == 0) {

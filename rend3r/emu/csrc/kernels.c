@@ -343,7 +343,7 @@ int64_t pair_marks(const Pairs *p, uint8_t *mark)
     const uint32_t *words = p->words;
     const int64_t *at = p->at;
     const uint8_t *tables = p->tables, *wanted = p->wanted, *null = p->null;
-    int64_t n = p->n, n_words = p->n_words, top = 0;
+    int64_t n = p->n, n_words = p->n_words, top = 0, last = -1;
     int32_t entry = p->entry, table;
     PairFields f = pair_fields(p);
     for (int64_t k = 0; k < n; k++) {
@@ -353,28 +353,38 @@ int64_t pair_marks(const Pairs *p, uint8_t *mark)
         if (!pair_stores(wanted, null, tables, entry, &f, k, se, &table))
             continue;
         int64_t index = ((int64_t)FIELD(f, se, 0) << f.hi_shift) | FIELD(f, se, 1);
-        mark[index] = 1;
-        top = index >= top ? index + 1 : top;
+        if (index != last) {  /* as in pair_apply */
+            last = index;
+            mark[index] = 1;
+            top = index >= top ? index + 1 : top;
+        }
     }
     return top;
 }
 
 /* Writes the pairs taken, in order, to a table of 32 property words per row (the last
- * write to a word wins), row row_of[index]. pair_marks checked the addresses. */
+ * write to a word wins), row row_of[index]. pair_marks checked the addresses. The row of
+ * the last index is kept: a shape's pairs mostly come together, and a store whose address
+ * waits on a row_of load each time ran at half the speed. */
 void pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values)
 {
     const uint32_t *words = p->words;
     const int64_t *at = p->at;
     const uint8_t *tables = p->tables, *wanted = p->wanted, *null = p->null;
-    int64_t n = p->n;
+    int64_t n = p->n, last = -1;
     int32_t entry = p->entry, table;
     PairFields f = pair_fields(p);
+    uint16_t *row = values;
     for (int64_t k = 0; k < n; k++) {
         uint32_t se = words[at[k]], sd = words[at[k] + 1];
         unsigned stores = pair_stores(wanted, null, tables, entry, &f, k, se, &table);
         if (!stores)
             continue;
-        uint16_t *row = values + 32 * (int64_t)row_of[((int64_t)FIELD(f, se, 0) << f.hi_shift) | FIELD(f, se, 1)];
+        int64_t index = ((int64_t)FIELD(f, se, 0) << f.hi_shift) | FIELD(f, se, 1);
+        if (index != last) {
+            last = index;
+            row = values + 32 * (int64_t)row_of[index];
+        }
         if (stores & 1u)
             row[FIELD(f, se, 2)] = (uint16_t)FIELD(f, sd, 4);
         if (stores & 2u)

@@ -1,8 +1,9 @@
 """The shape hierarchy: a bounding volume tree over the shapes, so a ray's cost grows with
 log(shapes).
 
-Built once per frame from the shapes' centres (``csrc/kernels.c`` bvh_build: median splits
-across the longest side, leaves of at most 4 shapes); each bundle of rays then refits its
+Built once per frame from the shapes' centres (``csrc/kernels.c`` bvh_build: splits along
+a Morton curve of the centres, halving the longest side of a node's cell first, leaves of
+at most 4 shapes); each bundle of rays then refits its
 node bounds to the balls of its own cull radii, and its depth floors (bvh_refit): double
 cones around the apex of lines through one point, boxes on the plane normal to parallel
 lines. Shapes without a

@@ -24,8 +24,10 @@
 #include "kernels.h"
 #include "simd.h"
 
-/* Shapes per leaf, at most, and the deepest a tree of 2**19 shapes gets (median splits:
- * ceil(log2(n / BVH_LEAF)) + 1 levels), with room to spare for traversal stacks. */
+/* Shapes per leaf, at most, and the room of the traversal stacks: a tree of 2**19 shapes
+ * is at most 30 levels of Morton bits deep plus ceil(log2(n / BVH_LEAF)) + 1 levels of
+ * median splits below them (kernels.c bvh_build, which also ends a branch in a leaf
+ * before it outgrows the stacks). */
 #define BVH_LEAF 4
 #define BVH_STACK 64
 

@@ -63,22 +63,86 @@ static void select_nth(BuildItem *a, int64_t lo, int64_t hi, int64_t k, int axis
     }
 }
 
-/* The hierarchy over the n shapes items (slots into bnd, whose centres are finite):
- * median splits of each node's shapes across the longest side of their centres' box,
- * leaves of at most BVH_LEAF. items is reordered leaf by leaf; node (2 ints per node, room
- * for 2n nodes) gets the nodes depth first. Returns the node count, or -1 when the
- * working copy cannot be allocated. */
+/* Bits per axis of the Morton codes that order the shapes before the splits, and the
+ * bits of a radix sort's digit. */
+#define MORTON_BITS 10
+#define DIGIT_BITS 8
+
+/* x's low MORTON_BITS bits spread to every third bit. */
+static inline uint64_t morton_spread(uint64_t x)
+{
+    x = (x | x << 16) & 0x030000FFu;
+    x = (x | x << 8) & 0x0300F00Fu;
+    x = (x | x << 4) & 0x030C30C3u;
+    return (x | x << 2) & 0x09249249u;
+}
+
+/* Sorts key[0..n) by bits 32 and up (stable, least significant digit first; digits that
+ * every key shares are skipped), with tmp of n as room; returns where the sorted keys are. */
+static uint64_t *radix_sort(uint64_t *key, uint64_t *tmp, int64_t n)
+{
+    for (int shift = 32; shift < 32 + 3 * MORTON_BITS; shift += DIGIT_BITS) {
+        int64_t start[(1 << DIGIT_BITS) + 1] = {0};
+        for (int64_t i = 0; i < n; i++)
+            start[(key[i] >> shift & ((1u << DIGIT_BITS) - 1)) + 1]++;
+        int one = 0;
+        for (int d = 0; d < 1 << DIGIT_BITS; d++) {
+            one |= start[d + 1] == n;
+            start[d + 1] += start[d];
+        }
+        if (one)
+            continue;
+        for (int64_t i = 0; i < n; i++)
+            tmp[start[key[i] >> shift & ((1u << DIGIT_BITS) - 1)]++] = key[i];
+        uint64_t *t = key; key = tmp; tmp = t;
+    }
+    return key;
+}
+
+/* The hierarchy over the n shapes items (slots into bnd, whose centres are finite). The
+ * shapes are ordered along a Morton curve of their centres, quantised to 2**MORTON_BITS
+ * steps per axis on the cube around them (an O(n) radix sort), and a node's shapes are
+ * split where the highest bit their codes differ in changes: halves of the cube's cell
+ * holding them, the longest side first. Shapes that share a code (closer than a step)
+ * are split at the median across the longest side of their centres' box (quickselect).
+ * Leaves hold at most BVH_LEAF shapes. items is reordered leaf by leaf; node (2 ints per
+ * node, room for 2n nodes) gets the nodes depth first. Returns the node count, or -1 when
+ * the working copies cannot be allocated. */
 int64_t bvh_build(const double *bnd, int32_t *items, int64_t n, int32_t *node)
 {
     int64_t stack[4 * BVH_STACK], top = 1, count = 0;
     if (n <= 0)
         return 0;
     BuildItem *a = malloc((size_t)n * sizeof *a);
-    if (a == NULL)
+    uint64_t *keys = malloc((size_t)n * 2 * sizeof *keys);
+    if (a == NULL || keys == NULL) {
+        free(a);
+        free(keys);
         return -1;
+    }
+    double lo3[3] = {INFINITY, INFINITY, INFINITY}, hi3[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int64_t i = 0; i < n; i++) {
         const double *c = bnd + B_COLUMNS * (int64_t)items[i];
-        a[i] = (BuildItem){{(float)c[0], (float)c[1], (float)c[2]}, items[i]};
+        for (int k = 0; k < 3; k++) { lo3[k] = MIN(lo3[k], c[k]); hi3[k] = MAX(hi3[k], c[k]); }
+    }
+    double side = MAX(MAX(hi3[0] - lo3[0], hi3[1] - lo3[1]), hi3[2] - lo3[2]);
+    double scale = side > 0 && side < INFINITY ? (double)(1 << MORTON_BITS) / side : 0.0;  /* else one code */
+    for (int64_t i = 0; i < n; i++) {
+        const double *c = bnd + B_COLUMNS * (int64_t)items[i];
+        uint64_t code = 0;
+        for (int k = 0; k < 3; k++) {
+            double q = (c[k] - lo3[k]) * scale;  /* in [0, 2**MORTON_BITS] */
+            uint32_t step = q < (1 << MORTON_BITS) - 1 ? (uint32_t)q : (1u << MORTON_BITS) - 1;
+            code |= morton_spread(step) << (2 - k);
+        }
+        keys[i] = code << 32 | (uint64_t)i;
+    }
+    uint64_t *key = radix_sort(keys, keys + n, n);
+    for (int64_t i = 0; i < n; i++) {
+        int32_t slot = items[key[i] & 0xFFFFFFFFu];
+        const double *c = bnd + B_COLUMNS * (int64_t)slot;
+        a[i] = (BuildItem){{(float)c[0], (float)c[1], (float)c[2]}, slot};
+        key[i] >>= 32;
     }
     /* pending ranges: lo, hi, the parent whose right child it is (-1: none), depth */
     stack[0] = 0; stack[1] = n; stack[2] = -1; stack[3] = 0;
@@ -93,15 +157,28 @@ int64_t bvh_build(const double *bnd, int32_t *items, int64_t n, int32_t *node)
             node[2 * at + 1] = (int32_t)(hi - lo);
             continue;
         }
-        float bl[3] = {INFINITY, INFINITY, INFINITY}, bh[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (int64_t i = lo; i < hi; i++)
-            for (int k = 0; k < 3; k++) { bl[k] = MIN(bl[k], a[i].c[k]); bh[k] = MAX(bh[k], a[i].c[k]); }
-        int axis = 0;
-        for (int k = 1; k < 3; k++)
-            if (bh[k] - bl[k] > bh[axis] - bl[axis])
-                axis = k;
-        int64_t mid = lo + (hi - lo) / 2;
-        select_nth(a, lo, hi, mid, axis);
+        int64_t mid;
+        uint64_t differ = key[lo] ^ key[hi - 1];  /* sorted: the range shares the bits above */
+        if (differ) {  /* the first shape with the highest differing bit set */
+            uint64_t bit = (uint64_t)1 << (63 - __builtin_clzll(differ));
+            int64_t l = lo, h = hi - 1;
+            while (l < h) {
+                int64_t m = l + (h - l) / 2;
+                if (key[m] & bit) h = m;
+                else l = m + 1;
+            }
+            mid = l;
+        } else {
+            float bl[3] = {INFINITY, INFINITY, INFINITY}, bh[3] = {-INFINITY, -INFINITY, -INFINITY};
+            for (int64_t i = lo; i < hi; i++)
+                for (int k = 0; k < 3; k++) { bl[k] = MIN(bl[k], a[i].c[k]); bh[k] = MAX(bh[k], a[i].c[k]); }
+            int axis = 0;
+            for (int k = 1; k < 3; k++)
+                if (bh[k] - bl[k] > bh[axis] - bl[axis])
+                    axis = k;
+            mid = lo + (hi - lo) / 2;
+            select_nth(a, lo, hi, mid, axis);
+        }
         node[2 * at + 1] = 0;
         int64_t right[4] = {mid, hi, at, depth + 1}, left[4] = {lo, mid, -1, depth + 1};
         memcpy(stack + 4 * top++, right, sizeof right);  /* after the left subtree */
@@ -110,6 +187,7 @@ int64_t bvh_build(const double *bnd, int32_t *items, int64_t n, int32_t *node)
     for (int64_t i = 0; i < n; i++)
         items[i] = a[i].slot;
     free(a);
+    free(keys);
     return count;
 }
 

@@ -37,9 +37,9 @@ OUT_TESTS, OUT_NAN_TESTS, OUT_SHADOW_RAYS, OUT_HITS, OUT_LO, OUT_HI = 0, 1, 2, 3
 OUT_SHOWN, OUT_NAN_RAYS, OUT_COLUMNS = 10, 11, 12
 PC_COLUMNS = 14
 BVH_CONE, BVH_FLAT = 0, 1  # a hierarchy's bounds around lines through one apex, or parallel lines
-BV_ANGLE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 4, 5, 11  # their columns (csrc/kernels.h)
+BV_SINE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 5, 6, 12  # their columns (csrc/kernels.h)
 BX_COLUMNS = 8  # a shape's own box on the axes normal to parallel lines (and rounded to floats)
-CI_COLUMNS = 4  # a shape's own cone around an apex: unit axis, half-angle
+CI_COLUMNS = 5  # a shape's own cone around an apex: unit axis, sine and cosine of its half-angle
 
 
 class Format(Structure):

@@ -101,6 +101,31 @@ def test_cones_hold_every_line_through_the_apex_that_meets_a_ball(n, seed):
         assert ((cross**2).sum(axis=1) <= (w**2).sum(axis=1) * b[at, native.BV_SIN2]).all()
 
 
+@settings(max_examples=40, derandomize=True)
+@given(st.integers(2, 200), st.integers(0, 2**32 - 1))
+def test_cones_hold_nested_and_nearly_parallel_cones(n, seed):
+    """Balls on a few lines through the apex, turned by 1e-15 to 1e-2 rad, from 1e-3 to 1e6
+    away, of angular radii 1e-14 to 1: cones nested in each other, axes nearly parallel
+    or opposite (lines), the cases where a cone's union cancels most."""
+    rng = np.random.default_rng(seed)
+    apex = rng.normal(size=3)
+    lines = rng.normal(size=(3, 3))
+    d = lines[rng.integers(0, 3, n)] + rng.normal(size=(n, 3)) * 10.0 ** rng.uniform(-15, -2, (n, 1))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    dist = 10.0 ** rng.uniform(-3, 6, n) * rng.choice([-1.0, 1.0], n)
+    bnd = table(apex + d * dist[:, None])
+    radius = np.abs(dist) * np.minimum(10.0 ** rng.uniform(-14, 0, n), 0.999)
+    tree = bvh.build(bnd, np.ones(n, bool))
+    b = tree.refit(bnd, radius, apex=apex).box
+    for at, below in leaves(tree):
+        c, r = bnd[below, :3] - apex, radius[below]
+        for sign in (-1.0, 1.0):  # lines from the apex through the balls' extreme points
+            offsets = np.cross(c, rng.normal(size=(len(below), 3)))
+            w = c + sign * r[:, None] * offsets / np.linalg.norm(offsets, axis=1)[:, None]
+            cross = np.cross(w, b[at, :3])
+            assert ((cross**2).sum(axis=1) <= (w**2).sum(axis=1) * b[at, native.BV_SIN2]).all()
+
+
 @settings(max_examples=30, derandomize=True)
 @given(st.integers(1, 300), st.integers(0, 2**32 - 1))
 def test_flat_boxes_hold_every_ball_projected_on_the_axes(n, seed):

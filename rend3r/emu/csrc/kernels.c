@@ -64,9 +64,10 @@ static void select_nth(BuildItem *a, int64_t lo, int64_t hi, int64_t k, int axis
 }
 
 /* Bits per axis of the Morton codes that order the shapes before the splits, and the
- * bits of a radix sort's digit. */
+ * bits of a radix sort's digit (three passes; with 8-bit digits, four passes took 2.7
+ * times as long: 256 runs 2 KB apart alias in the caches). */
 #define MORTON_BITS 10
-#define DIGIT_BITS 8
+#define DIGIT_BITS 10
 
 /* x's low MORTON_BITS bits spread to every third bit. */
 static inline uint64_t morton_spread(uint64_t x)
@@ -78,22 +79,36 @@ static inline uint64_t morton_spread(uint64_t x)
 }
 
 /* Sorts key[0..n) by bits 32 and up (stable, least significant digit first; digits that
- * every key shares are skipped), with tmp of n as room; returns where the sorted keys are. */
+ * every key shares are skipped), with tmp of n as room; returns where the sorted keys are.
+ * The two halves of the keys are scattered side by side, each with its own bucket
+ * offsets: runs of one digit (shapes listed in space order) then make two chains of
+ * increments rather than one. */
 static uint64_t *radix_sort(uint64_t *key, uint64_t *tmp, int64_t n)
 {
+    enum { BUCKETS = 1 << DIGIT_BITS };
+    int64_t half = n / 2;
     for (int shift = 32; shift < 32 + 3 * MORTON_BITS; shift += DIGIT_BITS) {
-        int64_t start[(1 << DIGIT_BITS) + 1] = {0};
+        int64_t start[2][BUCKETS] = {{0}};
         for (int64_t i = 0; i < n; i++)
-            start[(key[i] >> shift & ((1u << DIGIT_BITS) - 1)) + 1]++;
+            start[i >= half][key[i] >> shift & (BUCKETS - 1)]++;
+        int64_t sum = 0;
         int one = 0;
-        for (int d = 0; d < 1 << DIGIT_BITS; d++) {
-            one |= start[d + 1] == n;
-            start[d + 1] += start[d];
+        for (int d = 0; d < BUCKETS; d++) {
+            int64_t first = start[0][d], second = start[1][d];
+            one |= first + second == n;
+            start[0][d] = sum;
+            start[1][d] = sum + first;
+            sum += first + second;
         }
         if (one)
             continue;
-        for (int64_t i = 0; i < n; i++)
-            tmp[start[key[i] >> shift & ((1u << DIGIT_BITS) - 1)]++] = key[i];
+        for (int64_t i = 0; i < half; i++) {
+            uint64_t k0 = key[i], k1 = key[half + i];
+            tmp[start[0][k0 >> shift & (BUCKETS - 1)]++] = k0;
+            tmp[start[1][k1 >> shift & (BUCKETS - 1)]++] = k1;
+        }
+        if (n & 1)
+            tmp[start[1][key[n - 1] >> shift & (BUCKETS - 1)]++] = key[n - 1];
         uint64_t *t = key; key = tmp; tmp = t;
     }
     return key;
@@ -177,7 +192,8 @@ int64_t bvh_build(const double *bnd, int32_t *items, int64_t n, int32_t *node)
                 if (bh[k] - bl[k] > bh[axis] - bl[axis])
                     axis = k;
             mid = lo + (hi - lo) / 2;
-            select_nth(a, lo, hi, mid, axis);
+            if (bh[axis] > bl[axis])  /* else every centre is the same */
+                select_nth(a, lo, hi, mid, axis);
         }
         node[2 * at + 1] = 0;
         int64_t right[4] = {mid, hi, at, depth + 1}, left[4] = {lo, mid, -1, depth + 1};
@@ -191,35 +207,76 @@ int64_t bvh_build(const double *bnd, int32_t *items, int64_t n, int32_t *node)
     return count;
 }
 
-#define HALF_PI 1.5707963267948966  /* M_PI_2 is not C11 */
+/* A cone's half-angle t is kept as its sine and cosine; from CONE_EVERY on (t within
+ * 0.9 degree of pi/2, a cosine below 1/64) the cone holds every line, and its sine is
+ * inf. */
+#define CONE_EVERY 0.99987792197
 
-/* The double cone (unit axis a, half-angle t; t >= pi/2: every line) around the apex
- * holding cones 1 and 2 (lines: a2 flipped into a1's hemisphere), widened by 1e-12 of
- * the angle and 1e-12 rad at every step for the rounding of the construction. */
-static void cone_union(double *a1, double *t1, const double *a2_, double t2)
+/* The sine s and cosine of a half-angle widened by 1e-12 of s and 1e-13 (inf: every line),
+ * into cs. */
+static inline void cone_widen(double s, double *cs)
 {
-    double a2[3] = {a2_[0], a2_[1], a2_[2]}, dot = a1[0] * a2[0] + a1[1] * a2[1] + a1[2] * a2[2];
-    if (dot < 0) {
-        a2[0] = -a2[0]; a2[1] = -a2[1]; a2[2] = -a2[2]; dot = -dot;
-    }
-    double w[3] = {a2[0] - dot * a1[0], a2[1] - dot * a1[1], a2[2] - dot * a1[2]};
-    double sine = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), phi = atan2(sine, dot) * (1.0 + 1e-12) + 1e-15;
-    if (*t1 >= HALF_PI || phi + t2 <= *t1)
+    s = s * (1.0 + 1e-12) + 1e-13;
+    cs[0] = s < CONE_EVERY ? s : INFINITY;  /* NaN: every line */
+    cs[1] = s < CONE_EVERY ? sqrt((1.0 - s) * (1.0 + s)) : 0.0;
+}
+
+/* The double cone (unit axis a1, sine and cosine cs1 of its half-angle t1) around the
+ * apex made to hold cones 1 and 2 (lines: a2 counts as -a2 too), the smallest such cone,
+ * found with the addition and half-angle formulas rather than trigonometry. With phi the
+ * angle between the axes (cosine cp = |a1.a2|, sine sp = |a2 - cp a1|): cone 1 holds
+ * cone 2 when phi + t2 <= t1, cone 2 holds cone 1 when phi + t1 <= t2; otherwise the axis
+ * is a1 turned towards a2 by turn = (phi + t2 - t1) / 2, whose cosine and sine come from
+ * those of 2 turn, and the half-angle is t1 + turn. Every sine and cosine computed here
+ * is a sum of products of unit-bounded terms and at most two square roots away from the
+ * inputs, so it carries an absolute error of a few tens of ulps (2**-52) and the axis
+ * turns by as little; the result is widened by 1e-13 (cone_widen), over a hundred times
+ * that. */
+static void cone_union(double *a1, double *cs1, const double *a2_, const double *cs2)
+{
+    double s1 = cs1[0], c1 = cs1[1], s2 = cs2[0], c2 = cs2[1];
+    if (s1 >= CONE_EVERY)
         return;
-    if (t2 >= HALF_PI || phi + *t1 <= t2 || !(sine > 1e-9)) {
-        double keep = t2 >= *t1 ? t2 : *t1;
-        if (t2 >= *t1)
-            memcpy(a1, a2, sizeof a2);
-        *t1 = sine > 1e-9 ? t2 : keep + phi;
+    if (s2 >= CONE_EVERY) {
+        cs1[0] = INFINITY;
         return;
     }
-    double t = (phi + *t1 + t2) / 2, turn = t - *t1;
+    double a2[3] = {a2_[0], a2_[1], a2_[2]}, cp = a1[0] * a2[0] + a1[1] * a2[1] + a1[2] * a2[2];
+    if (cp < 0) {
+        a2[0] = -a2[0]; a2[1] = -a2[1]; a2[2] = -a2[2]; cp = -cp;
+    }
+    double w[3] = {a2[0] - cp * a1[0], a2[1] - cp * a1[1], a2[2] - cp * a1[2]};
+    double sp = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    double cq = cp * c2 - sp * s2, sq = sp * c2 + cp * s2;  /* phi + t2 */
+    double su = sq * c1 - cq * s1, cu = cq * c1 + sq * s1;  /* 2 turn = phi + t2 - t1, in (-pi/2, pi) */
+    if (!(su > 0)) {  /* cone 1 holds cone 2 */
+        cone_widen(s1, cs1);
+        return;
+    }
+    double cr = cp * c1 - sp * s1, sr = sp * c1 + cp * s1;  /* phi + t1 */
+    if (s2 * cr - c2 * sr >= 0) {  /* sin(t2 - phi - t1) >= 0: cone 2 holds cone 1 */
+        memcpy(a1, a2, sizeof a2);
+        cone_widen(s2, cs1);
+        return;
+    }
+    double ct, st;  /* turn in (0, phi), stably from 2 turn */
+    if (cu >= 0) {
+        ct = sqrt((1.0 + cu) / 2);
+        st = su / (2 * ct);
+    } else {
+        st = sqrt((1.0 - cu) / 2);
+        ct = su / (2 * st);
+    }
+    double axis[3], len = 0;
+    for (int c = 0; c < 3; c++) {
+        axis[c] = ct * a1[c] + st * w[c] / sp;
+        len += axis[c] * axis[c];
+    }
+    len = sqrt(len);
     for (int c = 0; c < 3; c++)
-        a1[c] = cos(turn) * a1[c] + sin(turn) * w[c] / sine;
-    double len = sqrt(a1[0] * a1[0] + a1[1] * a1[1] + a1[2] * a1[2]);
-    for (int c = 0; c < 3; c++)
-        a1[c] /= len;
-    *t1 = t * (1.0 + 1e-12) + 1e-12;
+        a1[c] = axis[c] / len;
+    double ct1 = ct * c1 - st * s1;  /* cos(t1 + turn) */
+    cone_widen(ct1 < 1.0 / 64 ? INFINITY : st * c1 + ct * s1, cs1);
 }
 
 /* A box's bounds (u0, u1, v0, v1) rounded outwards to floats, at out. */
@@ -237,8 +294,8 @@ static inline void box32(const double *b, double *out)
  * shapes' cones (CI_COLUMNS per item, from cone_items), for parallel lines (BVH_FLAT) the
  * boxes holding the shapes' boxes (BX_COLUMNS per item, from flat_items); and each node's
  * least floor (NULL: -inf). Children follow their parent, so nodes go last to first; a
- * cone gets the squared sine of its half-angle (inf from pi/2 on: every line) for the
- * kernels' test, a box its bounds rounded outwards to floats. */
+ * cone gets the squared sine of its half-angle (inf from CONE_EVERY on: every line) for
+ * the kernels' test, a box its bounds rounded outwards to floats. */
 void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items)
 {
     for (int64_t at = t->nodes - 1; at >= 0; at--) {
@@ -250,7 +307,8 @@ void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, con
         } else {
             b[BV_AXIS] = b[BV_AXIS + 1] = 0.0;
             b[BV_AXIS + 2] = 1.0;
-            b[BV_ANGLE] = -1.0;  /* no line yet */
+            b[BV_SINE] = -1.0;  /* no line yet */
+            b[BV_COS] = 0.0;
         }
         b[BV_FLOOR] = INFINITY;
         if (count == 0) {
@@ -260,8 +318,9 @@ void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, con
                 b[BV_V0] = MIN(l[BV_V0], r[BV_V0]); b[BV_V1] = MAX(l[BV_V1], r[BV_V1]);
             } else {
                 memcpy(b + BV_AXIS, l + BV_AXIS, 3 * sizeof(double));
-                b[BV_ANGLE] = l[BV_ANGLE];
-                cone_union(b + BV_AXIS, &b[BV_ANGLE], r + BV_AXIS, r[BV_ANGLE]);
+                b[BV_SINE] = l[BV_SINE];
+                b[BV_COS] = l[BV_COS];
+                cone_union(b + BV_AXIS, b + BV_SINE, r + BV_AXIS, r + BV_SINE);
             }
             b[BV_FLOOR] = MIN(l[BV_FLOOR], r[BV_FLOOR]);
         } else {
@@ -270,11 +329,12 @@ void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, con
                 b[BV_FLOOR] = MIN(b[BV_FLOOR], floor != NULL ? floor[s] : -INFINITY);
                 if (kind == BVH_CONE) {  /* the shape's own cone (cone_items) */
                     const double *o = items + CI_COLUMNS * (int64_t)i;
-                    if (b[BV_ANGLE] < 0) {
+                    if (b[BV_SINE] < 0) {
                         memcpy(b + BV_AXIS, o, 3 * sizeof(double));
-                        b[BV_ANGLE] = o[CI_ANGLE];
+                        b[BV_SINE] = o[CI_SINE];
+                        b[BV_COS] = o[CI_COS];
                     } else {
-                        cone_union(b + BV_AXIS, &b[BV_ANGLE], o, o[CI_ANGLE]);
+                        cone_union(b + BV_AXIS, b + BV_SINE, o, o + CI_SINE);
                     }
                     continue;
                 }
@@ -287,8 +347,8 @@ void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, con
         if (kind == BVH_FLAT)
             box32(b, b + BV_BOX32);
         if (kind == BVH_CONE) {
-            double sine = sin(b[BV_ANGLE]);
-            int cone = b[BV_ANGLE] < HALF_PI && b[BV_AXIS] == b[BV_AXIS];
+            double sine = b[BV_SINE];
+            int cone = sine < CONE_EVERY && b[BV_AXIS] == b[BV_AXIS];
             b[BV_SIN2] = cone ? sine * sine * (1.0 + 1e-9) : INFINITY;
             for (int c = 0; c < 3; c++)
                 b[BV_AXIS32 + c] = (float)b[BV_AXIS + c];

@@ -64,21 +64,22 @@ typedef struct {
 
 /* Shape hierarchy node columns (double, per bundle of rays; csrc/bvh.h): a bundle through
  * one apex (BVH_CONE) gets the double cone holding the lines that meet the balls below
- * (unit axis, half-angle, its squared sine), parallel lines (BVH_FLAT) the box of the
+ * (unit axis, the sine and cosine of its half-angle, its squared sine widened), parallel lines (BVH_FLAT) the box of the
  * balls' discs on two axes normal to them; then the least depth floor below, and that
  * floor rounded down to a float; a cone also gets its axis rounded to floats and the
  * widened squared sine of the float test (bvh.h cone_missed8), a box its bounds rounded
  * outwards to floats. */
 enum { BVH_CONE = 0, BVH_FLAT = 1 };
-enum { BV_AXIS = 0, BV_ANGLE = 3, BV_SIN2 = 4, BV_U0 = 0, BV_U1 = 1, BV_V0 = 2, BV_V1 = 3, BV_FLOOR = 5,
-       BV_FLOOR32 = 6, BV_AXIS32 = 7, BV_SIN2_32 = 10, BV_BOX32 = 7, BV_COLUMNS = 11 };
+enum { BV_AXIS = 0, BV_SINE = 3, BV_COS = 4, BV_SIN2 = 5, BV_U0 = 0, BV_U1 = 1, BV_V0 = 2, BV_V1 = 3,
+       BV_FLOOR = 6, BV_FLOOR32 = 7, BV_AXIS32 = 8, BV_SIN2_32 = 11, BV_BOX32 = 8, BV_COLUMNS = 12 };
 /* Parallel lines also get each shape's own box (BV_U0..BV_V1), per item in leaf order;
  * boxes also come rounded outwards to floats (at BV_BOX32 of a node, BX_BOX32 of an item:
  * u0, u1, v0, v1; bvh.h flat_missed8). */
 enum { BX_BOX32 = 4, BX_COLUMNS = 8 };
-/* A shape's own cone for lines through one apex (unit axis, half-angle), per item in leaf
- * order, while the nodes' cones are fitted (kernels.c bvh_refit). */
-enum { CI_ANGLE = 3, CI_COLUMNS = 4 };
+/* A shape's own cone for lines through one apex (unit axis, the sine and cosine of its
+ * half-angle: sine inf for every line), per item in leaf order, while the nodes' cones
+ * are fitted (kernels.c bvh_refit). */
+enum { CI_SINE = 3, CI_COS = 4, CI_COLUMNS = 5 };
 
 typedef struct {
     const int32_t *node;    /* per node: right child (inner) or first item (leaf), item count (0: inner);

@@ -85,12 +85,12 @@ def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
     ``bounded`` with a finite centre; the others go to the list every ray tests."""
     n = len(bnd)
     native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
-    inside = np.asarray(bounded, bool)  # and a finite centre (column by column: .all(axis=1) costs ten times more)
-    for k in range(3):
-        inside = inside & np.isfinite(bnd[:, k])
-    items = np.flatnonzero(inside).astype(np.int32)
-    node = np.empty((max(1, 2 * len(items)), 2), np.int32)
-    count = native.library().bvh_build(address(bnd), address(items), len(items), address(node))
-    if count < 0:
-        raise Rend3rError(f"not enough memory to build the shape hierarchy of {len(items):,} shapes")
-    return Tree(np.ascontiguousarray(node[:count]), items, np.flatnonzero(~inside).astype(np.int32))
+    ok = np.ascontiguousarray(bounded, bool).view(np.uint8)
+    native.ptr(ok, np.uint8, (n,))
+    items, always, node = np.empty(n, np.int32), np.empty(n, np.int32), np.empty((max(1, 2 * n), 2), np.int32)
+    counts = np.zeros(2, np.int64)
+    nodes = native.library().bvh_build(address(bnd), address(ok), n, address(items), address(always), address(node),
+                                       address(counts))
+    if nodes < 0:
+        raise Rend3rError(f"not enough memory to build the shape hierarchy of {int(counts[0]):,} shapes")
+    return Tree(node[:nodes], items[:counts[0]], always[:counts[1]])

@@ -138,9 +138,8 @@ NARROW, FORMAT = "nar", "fmt"
 _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and instruction set
     "directions": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "nearest": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
-    "origin_terms": (None, [POINTER(Shapes), c_void_p]),
-    "shape_tables": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p,
-                               c_void_p, c_void_p, POINTER(Format)]),
+    "shape_tables": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_double, c_void_p, c_void_p,
+                               c_void_p, c_void_p, c_void_p, POINTER(Format)]),
     "light_pass": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
     "shadow_origins": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
     "trace_pixel": (c_int64, [POINTER(Band), c_int32, c_int32, c_void_p, c_void_p, c_int64, c_int64, c_int64,
@@ -148,7 +147,7 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
 }
 _PLAIN = {
     "bvh_keys": (None, [POINTER(Bvh), c_void_p, c_void_p]),
-    "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p]),
+    "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
     "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_int32, c_void_p, c_void_p]),
     "have_avx2": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),

@@ -131,13 +131,11 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     if rays.rotation is not None:  # the kernel turns (x[col], y[row], z) per pixel
         cam[native.CAM_ROT:native.CAM_ROT + 4] = [np.asarray(c, dtype) for c in rays.rotation]
     fmt = None if ar.native else native.Format.of(ar)
-    sf, si, bnd, bounded, index = _shape_tables(scene, ar, fmt)
+    sf, si, bnd, bounded, index = _shape_tables(scene, ar, fmt, cam)
     lights = lights_from_scene(scene, ar, options.light_model)
     n = len(sf)
     view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
                          native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny, fmt)
-    if n:
-        native.kernel("origin_terms", ar)(byref(view), native.ptr(cam, dtype, (native.CAM_COLUMNS,)))
     return _Frame(ar, dtype, cam, np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype),
                   rays.rotation is not None, sf, si, index, bnd, bounded, lights,
                   _light_rows(lights, dtype), options.jobs or threads.available_cores(), view, bvh.build(bnd, bounded))
@@ -150,9 +148,10 @@ _KINDS = np.array([SHAPE_TYPE_CODES["sphere"], SHAPE_TYPE_CODES["cylinder"], SHA
                    lookup(Table.SHAPE, "type").value_mask], np.int32)
 
 
-def _shape_tables(scene: Scene, ar: Arith, fmt) -> tuple[np.ndarray, ...]:
-    """The shapes that are on, as the kernels' tables (csrc/datapath.inc shape_tables):
-    (floats, ints, bounds, bounded, program index), in index order. Spheres with moderate
+def _shape_tables(scene: Scene, ar: Arith, fmt, cam: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The shapes that are on, as the kernels' tables (csrc/datapath.inc shape_tables, with
+    the camera origin ``cam`` in each shape's normal space): (floats, ints, bounds,
+    bounded, program index), in index order. Spheres with moderate
     maps are bounded (culled, csrc/bounds.h) in every format: a test that overflows is a
     miss, and a format too coarse for the bounds (docs/emulator.md section 7) gets infinite
     cull radii from them."""
@@ -160,14 +159,15 @@ def _shape_tables(scene: Scene, ar: Arith, fmt) -> tuple[np.ndarray, ...]:
     values = np.ascontiguousarray(table.values, np.uint16)
     index = np.ascontiguousarray(table.index, np.int64)
     rows = len(index)
-    sf = np.empty((rows, native.SF_COLUMNS), native.dtype(ar))  # shape_tables and origin_terms fill it
+    sf = np.empty((rows, native.SF_COLUMNS), native.dtype(ar))  # shape_tables fills it
     si = np.empty((rows, native.SI_COLUMNS), np.int64)
     bnd = np.empty((rows, native.B_COLUMNS))
     bounded = np.empty(rows, np.uint8)
     out = np.empty(rows, np.int32)
     n = native.kernel("shape_tables", ar)(
         native.ptr(values, np.uint16, (rows, PROP_LIMIT)), address(index), rows, address(_SHAPE_PROPS),
-        address(_KINDS), address(sf), address(si), address(bnd), address(bounded), address(out), fmt)
+        address(_KINDS), native.ptr(cam, sf.dtype, (native.CAM_COLUMNS,)), ar.tiny, address(sf), address(si),
+        address(bnd), address(bounded), address(out), fmt)
     return sf[:n], si[:n], bnd[:n], bounded[:n].astype(bool), out[:n]
 
 

@@ -114,51 +114,66 @@ static uint64_t *radix_sort(uint64_t *key, uint64_t *tmp, int64_t n)
     return key;
 }
 
-/* The hierarchy over the n shapes items (slots into bnd, whose centres are finite). The
+/* The hierarchy over the shapes of bnd (n rows) that are bounded with a finite centre;
+ * their slots go to items (count[0] of them), the others' to always (count[1]). The
  * shapes are ordered along a Morton curve of their centres, quantised to 2**MORTON_BITS
  * steps per axis on the cube around them (an O(n) radix sort), and a node's shapes are
  * split where the highest bit their codes differ in changes: halves of the cube's cell
  * holding them, the longest side first. Shapes that share a code (closer than a step)
  * are split at the median across the longest side of their centres' box (quickselect).
- * Leaves hold at most BVH_LEAF shapes. items is reordered leaf by leaf; node (2 ints per
+ * Leaves hold at most BVH_LEAF shapes. items is ordered leaf by leaf; node (2 ints per
  * node, room for 2n nodes) gets the nodes depth first. Returns the node count, or -1 when
  * the working copies cannot be allocated. */
-int64_t bvh_build(const double *bnd, int32_t *items, int64_t n, int32_t *node)
+int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
+                  int32_t *node, int64_t *count_out)
 {
-    int64_t stack[4 * BVH_STACK], top = 1, count = 0;
-    if (n <= 0)
+    int64_t stack[4 * BVH_STACK], top = 1, count = 0, n = 0, outside = 0;
+    count_out[0] = count_out[1] = 0;
+    if (rows <= 0)
         return 0;
-    BuildItem *a = malloc((size_t)n * sizeof *a);
-    uint64_t *keys = malloc((size_t)n * 2 * sizeof *keys);
+    BuildItem *a = malloc((size_t)rows * 2 * sizeof *a);  /* the shapes, then in Morton order */
+    uint64_t *keys = malloc((size_t)rows * 2 * sizeof *keys);
     if (a == NULL || keys == NULL) {
         free(a);
         free(keys);
         return -1;
     }
-    double lo3[3] = {INFINITY, INFINITY, INFINITY}, hi3[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int64_t i = 0; i < n; i++) {
-        const double *c = bnd + B_COLUMNS * (int64_t)items[i];
-        for (int k = 0; k < 3; k++) { lo3[k] = MIN(lo3[k], c[k]); hi3[k] = MAX(hi3[k], c[k]); }
+    float lo3[3] = {INFINITY, INFINITY, INFINITY}, hi3[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int64_t s = 0; s < rows; s++) {
+        const double *c = bnd + B_COLUMNS * s;
+        if (!(bounded[s] && isfinite(c[0]) && isfinite(c[1]) && isfinite(c[2]))) {
+            always[outside++] = (int32_t)s;
+            continue;
+        }
+        BuildItem *t = a + n++;
+        *t = (BuildItem){{(float)c[0], (float)c[1], (float)c[2]}, (int32_t)s};
+        for (int k = 0; k < 3; k++) { lo3[k] = MIN(lo3[k], t->c[k]); hi3[k] = MAX(hi3[k], t->c[k]); }
     }
-    double side = MAX(MAX(hi3[0] - lo3[0], hi3[1] - lo3[1]), hi3[2] - lo3[2]);
+    count_out[0] = n;
+    count_out[1] = outside;
+    if (n == 0) {
+        free(a);
+        free(keys);
+        return 0;
+    }
+    double side = MAX(MAX((double)hi3[0] - lo3[0], (double)hi3[1] - lo3[1]), (double)hi3[2] - lo3[2]);
     double scale = side > 0 && side < INFINITY ? (double)(1 << MORTON_BITS) / side : 0.0;  /* else one code */
     for (int64_t i = 0; i < n; i++) {
-        const double *c = bnd + B_COLUMNS * (int64_t)items[i];
         uint64_t code = 0;
         for (int k = 0; k < 3; k++) {
-            double q = (c[k] - lo3[k]) * scale;  /* in [0, 2**MORTON_BITS] */
+            double q = ((double)a[i].c[k] - lo3[k]) * scale;  /* in [0, 2**MORTON_BITS] */
             uint32_t step = q < (1 << MORTON_BITS) - 1 ? (uint32_t)q : (1u << MORTON_BITS) - 1;
             code |= morton_spread(step) << (2 - k);
         }
         keys[i] = code << 32 | (uint64_t)i;
     }
     uint64_t *key = radix_sort(keys, keys + n, n);
+    BuildItem *sorted = a + n;
     for (int64_t i = 0; i < n; i++) {
-        int32_t slot = items[key[i] & 0xFFFFFFFFu];
-        const double *c = bnd + B_COLUMNS * (int64_t)slot;
-        a[i] = (BuildItem){{(float)c[0], (float)c[1], (float)c[2]}, slot};
+        sorted[i] = a[key[i] & 0xFFFFFFFFu];
         key[i] >>= 32;
     }
+    a = sorted;
     /* pending ranges: lo, hi, the parent whose right child it is (-1: none), depth */
     stack[0] = 0; stack[1] = n; stack[2] = -1; stack[3] = 0;
     while (top > 0) {
@@ -202,7 +217,7 @@ int64_t bvh_build(const double *bnd, int32_t *items, int64_t n, int32_t *node)
     }
     for (int64_t i = 0; i < n; i++)
         items[i] = a[i].slot;
-    free(a);
+    free(a - n);
     free(keys);
     return count;
 }

@@ -69,46 +69,58 @@ static void select_nth(BuildItem *a, int64_t lo, int64_t hi, int64_t k, int axis
 #define MORTON_BITS 10
 #define DIGIT_BITS 10
 
-/* x's low MORTON_BITS bits spread to every third bit. */
-static inline uint64_t morton_spread(uint64_t x)
+/* x's low MORTON_BITS bits (10) spread to every third bit, five bits at a time. */
+static inline uint64_t morton_spread(uint32_t x)
 {
-    x = (x | x << 16) & 0x030000FFu;
-    x = (x | x << 8) & 0x0300F00Fu;
-    x = (x | x << 4) & 0x030C30C3u;
-    return (x | x << 2) & 0x09249249u;
+    static const uint16_t five[32] = {
+        0x0000, 0x0001, 0x0008, 0x0009, 0x0040, 0x0041, 0x0048, 0x0049, 0x0200, 0x0201, 0x0208, 0x0209, 0x0240,
+        0x0241, 0x0248, 0x0249, 0x1000, 0x1001, 0x1008, 0x1009, 0x1040, 0x1041, 0x1048, 0x1049, 0x1200, 0x1201,
+        0x1208, 0x1209, 0x1240, 0x1241, 0x1248, 0x1249};
+    return (uint64_t)five[x & 31] | (uint64_t)five[x >> 5 & 31] << 15;
 }
 
 /* Sorts key[0..n) by bits 32 and up (stable, least significant digit first; digits that
  * every key shares are skipped), with tmp of n as room; returns where the sorted keys are.
- * The two halves of the keys are scattered side by side, each with its own bucket
- * offsets: runs of one digit (shapes listed in space order) then make two chains of
- * increments rather than one. */
+ * The keys' four quarters are counted and scattered side by side, each with its own
+ * bucket counts: shapes listed in space order make long runs of one digit, and one
+ * counter's chain of increments took twice the time. */
 static uint64_t *radix_sort(uint64_t *key, uint64_t *tmp, int64_t n)
 {
-    enum { BUCKETS = 1 << DIGIT_BITS };
-    int64_t half = n / 2;
+    enum { BUCKETS = 1 << DIGIT_BITS, MASK = BUCKETS - 1, Q = 4 };
+    int64_t edge[Q + 1], len = n / Q;  /* the quarters, and the length they share (the rest after) */
+    for (int q = 0; q <= Q; q++)
+        edge[q] = n * q / Q;
     for (int shift = 32; shift < 32 + 3 * MORTON_BITS; shift += DIGIT_BITS) {
-        int64_t start[2][BUCKETS] = {{0}};
-        for (int64_t i = 0; i < n; i++)
-            start[i >= half][key[i] >> shift & (BUCKETS - 1)]++;
+        int64_t at[Q][BUCKETS];
+        memset(at, 0, sizeof at);
+        for (int64_t i = 0; i < len; i++)
+            for (int q = 0; q < Q; q++)
+                at[q][key[edge[q] + i] >> shift & MASK]++;
+        for (int q = 0; q < Q; q++)
+            for (int64_t i = edge[q] + len; i < edge[q + 1]; i++)
+                at[q][key[i] >> shift & MASK]++;
         int64_t sum = 0;
         int one = 0;
-        for (int d = 0; d < BUCKETS; d++) {
-            int64_t first = start[0][d], second = start[1][d];
-            one |= first + second == n;
-            start[0][d] = sum;
-            start[1][d] = sum + first;
-            sum += first + second;
+        for (int d = 0; d < BUCKETS; d++) {  /* each quarter's first place per digit */
+            int64_t total = 0;
+            for (int q = 0; q < Q; q++) {
+                int64_t c = at[q][d];
+                at[q][d] = sum + total;
+                total += c;
+            }
+            one |= total == n;
+            sum += total;
         }
         if (one)
             continue;
-        for (int64_t i = 0; i < half; i++) {
-            uint64_t k0 = key[i], k1 = key[half + i];
-            tmp[start[0][k0 >> shift & (BUCKETS - 1)]++] = k0;
-            tmp[start[1][k1 >> shift & (BUCKETS - 1)]++] = k1;
-        }
-        if (n & 1)
-            tmp[start[1][key[n - 1] >> shift & (BUCKETS - 1)]++] = key[n - 1];
+        for (int64_t i = 0; i < len; i++)
+            for (int q = 0; q < Q; q++) {
+                uint64_t k = key[edge[q] + i];
+                tmp[at[q][k >> shift & MASK]++] = k;
+            }
+        for (int q = 0; q < Q; q++)
+            for (int64_t i = edge[q] + len; i < edge[q + 1]; i++)
+                tmp[at[q][key[i] >> shift & MASK]++] = key[i];
         uint64_t *t = key; key = tmp; tmp = t;
     }
     return key;

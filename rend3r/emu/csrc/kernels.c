@@ -132,7 +132,8 @@ static uint64_t *radix_sort(uint64_t *key, uint64_t *tmp, int64_t n)
  * steps per axis on the cube around them (an O(n) radix sort), and a node's shapes are
  * split where the highest bit their codes differ in changes: halves of the cube's cell
  * holding them, the longest side first. Shapes that share a code (closer than a step)
- * are split at the median across the longest side of their centres' box (quickselect).
+ * are split across the longest side of their centres' box (quickselect) at the median
+ * rounded up to whole leaves.
  * Leaves hold at most BVH_LEAF shapes. items is ordered leaf by leaf; node (2 ints per
  * node, room for 2n nodes) gets the nodes depth first. Returns the node count, or -1 when
  * the working copies cannot be allocated. */
@@ -218,7 +219,7 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
             for (int k = 1; k < 3; k++)
                 if (bh[k] - bl[k] > bh[axis] - bl[axis])
                     axis = k;
-            mid = lo + (hi - lo) / 2;
+            mid = lo + ((hi - lo) / 2 + BVH_LEAF - 1) / BVH_LEAF * BVH_LEAF;  /* full leaves: fewer nodes */
             if (bh[axis] > bl[axis])  /* else every centre is the same */
                 select_nth(a, lo, hi, mid, axis);
         }

@@ -155,6 +155,7 @@ _PLAIN = {
                            c_void_p, c_void_p]),
     "pair_marks": (c_int64, [POINTER(Pairs), c_void_p]),
     "pair_apply": (None, [POINTER(Pairs), c_void_p, c_void_p]),
+    "mark_rows": (c_int64, [c_void_p, c_int64, c_void_p, c_void_p]),
 }
 _PER_ISA = {  # name: (restype, argtypes); each exists once per instruction set (double lanes)
     "primary_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,

@@ -57,11 +57,12 @@ class ObjectTable:
         index below ``top`` that has one (int32; the others are undefined)."""
         if mark.shape != (SHAPE_INDEX_LIMIT,) or mark.dtype != np.uint8:
             raise ValueError(f"grow: the marks must be {SHAPE_INDEX_LIMIT} bytes")
+        from .native import address, library  # the compiled pass: numpy's nonzero and scatter took twice as long
+
         top = max(top, int(self.index[-1]) + 1 if len(self.index) else 0)
         mark[self.index] = 1
-        merged = np.flatnonzero(mark[:top])
-        row_of = np.empty(top, np.int32)
-        row_of[merged] = np.arange(len(merged), dtype=np.int32)
+        row_of, merged = np.empty(top, np.int32), np.empty(top, np.int64)
+        merged = merged[:library().mark_rows(address(mark), top, address(row_of), address(merged))]
         if len(merged) > len(self.index):
             values = np.zeros((len(merged), PROP_LIMIT), dtype=np.uint16)
             values[row_of[self.index]] = self.values

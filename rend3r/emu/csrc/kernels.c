@@ -559,6 +559,20 @@ void pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values)
 }
 #undef FIELD
 
+/* The rows of the indices marked below top (mark[i] != 0), in index order: row_of[i] of
+ * each marked i (the others' are left undefined), and the marked indices into index
+ * (room for top). Returns how many are marked. */
+int64_t mark_rows(const uint8_t *mark, int64_t top, int32_t *row_of, int64_t *index)
+{
+    int64_t r = 0;
+    for (int64_t i = 0; i < top; i++) {
+        row_of[i] = (int32_t)r;
+        index[r] = i;
+        r += mark[i] != 0;
+    }
+    return r;
+}
+
 /* ---- rounding, for tests ---- */
 
 void round16_array(const float *in, float *out, int64_t n, int32_t ftz)

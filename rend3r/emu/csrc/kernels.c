@@ -307,15 +307,76 @@ static void cone_union(double *a1, double *cs1, const double *a2_, const double 
     cone_widen(ct1 < 1.0 / 64 ? INFINITY : st * c1 + ct * s1, cs1);
 }
 
-/* A box's bounds (u0, u1, v0, v1) rounded outwards to floats, at out. */
-static inline void box32(const double *b, double *out)
-{
-    out[0] = floor32(b[BV_U0]); out[1] = ceil32(b[BV_U1]);
-    out[2] = floor32(b[BV_V0]); out[3] = ceil32(b[BV_V1]);
-}
-
 /* A float's unit roundoff, 2**-24. */
 #define U32 5.9604644775390625e-08
+
+/* bvh_refit for parallel lines: per node the box holding its shapes' boxes, its least
+ * floor, both rounded outwards to floats. The bounds are joined in locals (reading back
+ * the stores as a vector stalled on store forwarding). */
+static void refit_flat(const Bvh *t, const double *floor, double *box, const double *items)
+{
+    for (int64_t at = t->nodes - 1; at >= 0; at--) {
+        double *b = box + BV_COLUMNS * at;
+        int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
+        double u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY, fl = INFINITY;
+        if (count == 0) {
+            const double *l = box + BV_COLUMNS * (at + 1), *r = box + BV_COLUMNS * (int64_t)first;
+            u0 = MIN(l[BV_U0], r[BV_U0]); u1 = MAX(l[BV_U1], r[BV_U1]);
+            v0 = MIN(l[BV_V0], r[BV_V0]); v1 = MAX(l[BV_V1], r[BV_V1]);
+            fl = MIN(l[BV_FLOOR], r[BV_FLOOR]);
+        }
+        for (int32_t i = first; count > 0 && i < first + count; i++) {
+            const double *o = items + BX_COLUMNS * (int64_t)i;  /* the shape's own box (flat_items) */
+            fl = MIN(fl, floor != NULL ? floor[t->items[i]] : -INFINITY);
+            u0 = MIN(u0, o[BV_U0]); u1 = MAX(u1, o[BV_U1]);
+            v0 = MIN(v0, o[BV_V0]); v1 = MAX(v1, o[BV_V1]);
+        }
+        b[BV_U0] = u0; b[BV_U1] = u1; b[BV_V0] = v0; b[BV_V1] = v1;
+        b[BV_FLOOR] = fl;
+        b[BV_FLOOR32] = floor32(fl);
+        b[BV_BOX32] = floor32(u0); b[BV_BOX32 + 1] = ceil32(u1);
+        b[BV_BOX32 + 2] = floor32(v0); b[BV_BOX32 + 3] = ceil32(v1);
+    }
+}
+
+/* bvh_refit for lines through an apex: per node the double cone holding its shapes'
+ * cones, its least floor, the cone's squared sine for the tests. */
+static void refit_cones(const Bvh *t, const double *floor, double *box, const double *items)
+{
+    for (int64_t at = t->nodes - 1; at >= 0; at--) {
+        double *b = box + BV_COLUMNS * at;
+        int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
+        double fl = INFINITY;
+        if (count == 0) {
+            const double *l = box + BV_COLUMNS * (at + 1), *r = box + BV_COLUMNS * (int64_t)first;
+            memcpy(b + BV_AXIS, l + BV_AXIS, 3 * sizeof(double));
+            b[BV_SINE] = l[BV_SINE];
+            b[BV_COS] = l[BV_COS];
+            cone_union(b + BV_AXIS, b + BV_SINE, r + BV_AXIS, r + BV_SINE);
+            fl = MIN(l[BV_FLOOR], r[BV_FLOOR]);
+        }
+        for (int32_t i = first; count > 0 && i < first + count; i++) {
+            const double *o = items + CI_COLUMNS * (int64_t)i;  /* the shape's own cone (cone_items) */
+            fl = MIN(fl, floor != NULL ? floor[t->items[i]] : -INFINITY);
+            if (i == first) {
+                memcpy(b + BV_AXIS, o, 3 * sizeof(double));
+                b[BV_SINE] = o[CI_SINE];
+                b[BV_COS] = o[CI_COS];
+            } else {
+                cone_union(b + BV_AXIS, b + BV_SINE, o, o + CI_SINE);
+            }
+        }
+        b[BV_FLOOR] = fl;
+        b[BV_FLOOR32] = floor32(fl);
+        double sine = b[BV_SINE];
+        int cone = sine < CONE_EVERY && b[BV_AXIS] == b[BV_AXIS];
+        b[BV_SIN2] = cone ? sine * sine * (1.0 + 1e-9) : INFINITY;
+        for (int c = 0; c < 3; c++)
+            b[BV_AXIS32 + c] = (float)b[BV_AXIS + c];
+        b[BV_SIN2_32] = cone ? ceil32((sine * (1.0 + 1e-9) + 8 * U32) * (sine * (1.0 + 1e-9) + 8 * U32)
+                                      * (1.0 + 10 * U32)) : INFINITY;
+    }
+}
 
 /* One bundle's node bounds (t->nodes x BV_COLUMNS into box) from its shapes' own bounds
  * (items, in leaf order): for BVH_CONE the double cones around the apex holding the
@@ -326,64 +387,10 @@ static inline void box32(const double *b, double *out)
  * the kernels' test, a box its bounds rounded outwards to floats. */
 void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items)
 {
-    for (int64_t at = t->nodes - 1; at >= 0; at--) {
-        double *b = box + BV_COLUMNS * at;
-        int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
-        if (kind == BVH_FLAT) {
-            b[BV_U0] = b[BV_V0] = INFINITY;
-            b[BV_U1] = b[BV_V1] = -INFINITY;
-        } else {
-            b[BV_AXIS] = b[BV_AXIS + 1] = 0.0;
-            b[BV_AXIS + 2] = 1.0;
-            b[BV_SINE] = -1.0;  /* no line yet */
-            b[BV_COS] = 0.0;
-        }
-        b[BV_FLOOR] = INFINITY;
-        if (count == 0) {
-            const double *l = box + BV_COLUMNS * (at + 1), *r = box + BV_COLUMNS * (int64_t)first;
-            if (kind == BVH_FLAT) {
-                b[BV_U0] = MIN(l[BV_U0], r[BV_U0]); b[BV_U1] = MAX(l[BV_U1], r[BV_U1]);
-                b[BV_V0] = MIN(l[BV_V0], r[BV_V0]); b[BV_V1] = MAX(l[BV_V1], r[BV_V1]);
-            } else {
-                memcpy(b + BV_AXIS, l + BV_AXIS, 3 * sizeof(double));
-                b[BV_SINE] = l[BV_SINE];
-                b[BV_COS] = l[BV_COS];
-                cone_union(b + BV_AXIS, b + BV_SINE, r + BV_AXIS, r + BV_SINE);
-            }
-            b[BV_FLOOR] = MIN(l[BV_FLOOR], r[BV_FLOOR]);
-        } else {
-            for (int32_t i = first; i < first + count; i++) {
-                int64_t s = t->items[i];
-                b[BV_FLOOR] = MIN(b[BV_FLOOR], floor != NULL ? floor[s] : -INFINITY);
-                if (kind == BVH_CONE) {  /* the shape's own cone (cone_items) */
-                    const double *o = items + CI_COLUMNS * (int64_t)i;
-                    if (b[BV_SINE] < 0) {
-                        memcpy(b + BV_AXIS, o, 3 * sizeof(double));
-                        b[BV_SINE] = o[CI_SINE];
-                        b[BV_COS] = o[CI_COS];
-                    } else {
-                        cone_union(b + BV_AXIS, b + BV_SINE, o, o + CI_SINE);
-                    }
-                    continue;
-                }
-                const double *o = items + BX_COLUMNS * (int64_t)i;  /* the shape's own box (flat_items) */
-                b[BV_U0] = MIN(b[BV_U0], o[BV_U0]); b[BV_U1] = MAX(b[BV_U1], o[BV_U1]);
-                b[BV_V0] = MIN(b[BV_V0], o[BV_V0]); b[BV_V1] = MAX(b[BV_V1], o[BV_V1]);
-            }
-        }
-        b[BV_FLOOR32] = floor32(b[BV_FLOOR]);
-        if (kind == BVH_FLAT)
-            box32(b, b + BV_BOX32);
-        if (kind == BVH_CONE) {
-            double sine = b[BV_SINE];
-            int cone = sine < CONE_EVERY && b[BV_AXIS] == b[BV_AXIS];
-            b[BV_SIN2] = cone ? sine * sine * (1.0 + 1e-9) : INFINITY;
-            for (int c = 0; c < 3; c++)
-                b[BV_AXIS32 + c] = (float)b[BV_AXIS + c];
-            b[BV_SIN2_32] = cone ? ceil32((sine * (1.0 + 1e-9) + 8 * U32) * (sine * (1.0 + 1e-9) + 8 * U32)
-                                          * (1.0 + 10 * U32)) : INFINITY;
-        }
-    }
+    if (kind == BVH_FLAT)
+        refit_flat(t, floor, box, items);
+    else
+        refit_cones(t, floor, box, items);
 }
 
 /* Per node of t, the largest of each of its shapes' stop keys (shadow_shapes; out: 3 per

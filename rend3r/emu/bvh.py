@@ -36,12 +36,15 @@ class Tree:
         return len(self.node)
 
     def refit(self, bnd: np.ndarray, radius: np.ndarray, floor: np.ndarray | None = None, *,
-              apex: np.ndarray | None = None, axes: np.ndarray | None = None) -> Bounds:
+              apex: np.ndarray | None = None, axes: np.ndarray | None = None,
+              keys: np.ndarray | None = None) -> Bounds:
         """One bundle's node bounds around the balls (centre, ``radius``) of their shapes,
         and their least ``floor`` (None: -inf): the double cones around ``apex`` (lines
         through it) or the boxes on the two unit ``axes`` (2, 3) normal to parallel lines,
-        with each shape's own box for parallel lines. Each shape's own bound is computed
-        first, four shapes at a time (csrc/shape_bounds.inc), then joined node by node."""
+        with each shape's own box for parallel lines, and per node the largest of its
+        shapes' stop ``keys`` (n, 3; parallel lines only). Each shape's own bound is
+        computed first, four shapes at a time (csrc/shape_bounds.inc), then joined node by
+        node."""
         n = len(bnd)
         native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
         radius = np.ascontiguousarray(radius, np.float64)
@@ -50,6 +53,10 @@ class Tree:
             native.ptr(floor, np.float64, (n,))
         if (apex is None) == (axes is None):
             raise ValueError("refit: give the apex of the lines or the axes normal to them")
+        if keys is not None:
+            if axes is None:
+                raise ValueError("refit: stop keys are for parallel lines")
+            native.ptr(keys, np.float64, (n, 3))
         kind = native.BVH_CONE if apex is not None else native.BVH_FLAT
         frame = np.zeros(6)
         frame[: 3 if apex is not None else 6] = np.ravel(apex if apex is not None else axes)
@@ -57,9 +64,11 @@ class Tree:
         own = np.empty((len(self.items), native.CI_COLUMNS if apex is not None else native.BX_COLUMNS))
         native.shape_pass("cone_items" if apex is not None else "flat_items")(
             address(self.items), len(self.items), address(bnd), address(radius), address(frame), address(own))
-        bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame, own if axes is not None else None)
+        bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame, own if axes is not None else None,
+                        None if keys is None else np.empty((self.nodes, 3)))
         native.library().bvh_refit(bounds.struct(), None if floor is None else address(floor), kind,
-                                   address(bounds.box), address(own))
+                                   address(bounds.box), address(own), None if keys is None else address(keys),
+                                   None if keys is None else address(bounds.keys))
         return bounds
 
 
@@ -71,6 +80,7 @@ class Bounds:
     box: np.ndarray  # (nodes, BV_COLUMNS) float64
     frame: np.ndarray  # 6 float64
     item_box: np.ndarray | None = None  # parallel lines: (items, BX_COLUMNS), each shape's own box
+    keys: np.ndarray | None = None  # parallel lines with stop keys: (nodes, 3), the largest below each node
 
     def struct(self) -> native.Bvh:
         """The kernels' view (the arrays must outlive it)."""

@@ -405,10 +405,8 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
         return _unbounded(fr, lp)
     radius, behind, keys = bounds.shadow(fr.bnd, fr.bounded, lo, hi, length, *limits, unit=unit, length=length,
                                          jobs=fr.jobs)
-    flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit))
-    node_keys = np.empty((fr.tree.nodes, 3))
-    native.library().bvh_keys(flat.struct(), address(keys), address(node_keys))
-    return _ShadowBounds(radius, flat, behind, node_keys, length, unit)
+    flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit), keys=keys)
+    return _ShadowBounds(radius, flat, behind, flat.keys, length, unit)
 
 
 def _unbounded(fr: _Frame, lp: native.LightPass) -> _ShadowBounds:

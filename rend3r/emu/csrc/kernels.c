@@ -311,26 +311,39 @@ static void cone_union(double *a1, double *cs1, const double *a2_, const double 
 #define U32 5.9604644775390625e-08
 
 /* bvh_refit for parallel lines: per node the box holding its shapes' boxes, its least
- * floor, both rounded outwards to floats. The bounds are joined in locals (reading back
- * the stores as a vector stalled on store forwarding). */
-static void refit_flat(const Bvh *t, const double *floor, double *box, const double *items)
+ * floor, both rounded outwards to floats, and where keys is not NULL the largest of each
+ * of its shapes' stop keys (3 per shape, shape_bounds.inc shadow_shapes; 3 per node into
+ * node_keys): a packet for which the keys' test holds has every shape below the node
+ * behind every origin (K1 multiplies spread >= 0, so the test only gets harder as keys
+ * grow). The bounds are joined in locals (reading back the stores as a vector stalled on
+ * store forwarding). */
+static void refit_flat(const Bvh *t, const double *floor, double *box, const double *items, const double *keys,
+                       double *node_keys)
 {
     for (int64_t at = t->nodes - 1; at >= 0; at--) {
         double *b = box + BV_COLUMNS * at;
         int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
         double u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY, fl = INFINITY;
+        double k[3] = {-INFINITY, -INFINITY, -INFINITY};
         if (count == 0) {
             const double *l = box + BV_COLUMNS * (at + 1), *r = box + BV_COLUMNS * (int64_t)first;
             u0 = MIN(l[BV_U0], r[BV_U0]); u1 = MAX(l[BV_U1], r[BV_U1]);
             v0 = MIN(l[BV_V0], r[BV_V0]); v1 = MAX(l[BV_V1], r[BV_V1]);
             fl = MIN(l[BV_FLOOR], r[BV_FLOOR]);
+            for (int c = 0; keys != NULL && c < 3; c++)
+                k[c] = MAX(node_keys[3 * (at + 1) + c], node_keys[3 * (int64_t)first + c]);
         }
         for (int32_t i = first; count > 0 && i < first + count; i++) {
             const double *o = items + BX_COLUMNS * (int64_t)i;  /* the shape's own box (flat_items) */
-            fl = MIN(fl, floor != NULL ? floor[t->items[i]] : -INFINITY);
+            int64_t s = t->items[i];
+            fl = MIN(fl, floor != NULL ? floor[s] : -INFINITY);
             u0 = MIN(u0, o[BV_U0]); u1 = MAX(u1, o[BV_U1]);
             v0 = MIN(v0, o[BV_V0]); v1 = MAX(v1, o[BV_V1]);
+            for (int c = 0; keys != NULL && c < 3; c++)
+                k[c] = MAX(k[c], keys[3 * s + c]);
         }
+        if (keys != NULL)
+            memcpy(node_keys + 3 * at, k, sizeof k);
         b[BV_U0] = u0; b[BV_U1] = u1; b[BV_V0] = v0; b[BV_V1] = v1;
         b[BV_FLOOR] = fl;
         b[BV_FLOOR32] = floor32(fl);
@@ -382,36 +395,17 @@ static void refit_cones(const Bvh *t, const double *floor, double *box, const do
  * (items, in leaf order): for BVH_CONE the double cones around the apex holding the
  * shapes' cones (CI_COLUMNS per item, from cone_items), for parallel lines (BVH_FLAT) the
  * boxes holding the shapes' boxes (BX_COLUMNS per item, from flat_items); and each node's
- * least floor (NULL: -inf). Children follow their parent, so nodes go last to first; a
- * cone gets the squared sine of its half-angle (inf from CONE_EVERY on: every line) for
- * the kernels' test, a box its bounds rounded outwards to floats. */
-void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items)
+ * least floor (NULL: -inf); boxes also the stop keys of a directional light's shadow rays
+ * (keys NULL: none; refit_flat). Children follow their parent, so nodes go last to
+ * first; a cone gets the squared sine of its half-angle (inf from CONE_EVERY on: every
+ * line) for the kernels' test, a box its bounds rounded outwards to floats. */
+void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items, const double *keys,
+               double *node_keys)
 {
     if (kind == BVH_FLAT)
-        refit_flat(t, floor, box, items);
+        refit_flat(t, floor, box, items, keys, node_keys);
     else
         refit_cones(t, floor, box, items);
-}
-
-/* Per node of t, the largest of each of its shapes' stop keys (shadow_shapes; out: 3 per
- * node): a packet for which the keys' test holds has every shape below it behind every
- * origin (K1 multiplies spread >= 0, so the test only gets harder as keys grow). */
-void bvh_keys(const Bvh *t, const double *keys, double *out)
-{
-    for (int64_t at = t->nodes - 1; at >= 0; at--) {
-        double *o = out + 3 * at;
-        int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
-        for (int c = 0; c < 3; c++)
-            o[c] = -INFINITY;
-        if (count == 0) {
-            for (int c = 0; c < 3; c++)
-                o[c] = MAX(out[3 * (at + 1) + c], out[3 * (int64_t)first + c]);
-            continue;
-        }
-        for (int32_t i = first; i < first + count; i++)
-            for (int c = 0; c < 3; c++)
-                o[c] = MAX(o[c], keys[3 * (int64_t)t->items[i] + c]);
-    }
 }
 
 /* ---- bounds per shape (rend3r/emu/bounds.py) ---- */

@@ -138,7 +138,7 @@ typedef struct {            /* one light over one band */
     const double *radius;   /* cull radius per shape, for these shadow rays */
     Bvh tree;               /* the shapes, with these shadow rays' boxes */
     const double *keys;     /* directional light (else NULL): per node the largest stop keys below it
-                               (shape_bounds.inc shadow_shapes, kernels.c bvh_keys) */
+                               (shape_bounds.inc shadow_shapes, kernels.c bvh_refit) */
 } LightPass;
 
 /* The row within its band of pixel p: (p * row_magic) >> 40 equals p / width exactly for

@@ -102,5 +102,5 @@ def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
     nodes = native.library().bvh_build(address(bnd), address(ok), n, address(items), address(always), address(node),
                                        address(counts))
     if nodes < 0:
-        raise Rend3rError(f"not enough memory to build the shape hierarchy of {int(counts[0]):,} shapes")
+        raise Rend3rError(f"not enough memory to build the shape hierarchy of {n:,} shapes")
     return Tree(node[:nodes], items[:counts[0]], always[:counts[1]])

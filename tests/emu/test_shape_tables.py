@@ -9,15 +9,14 @@ from __future__ import annotations
 import numpy as np
 from hypothesis import given, settings, strategies as st
 
+from rend3r.emu import native
 from rend3r.emu.arith import make_arith
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.raytracer import set_up
 from rend3r.emu.scene import Scene, prop_index
+from rend3r.emu.shapes import shapes_from_scene
 from rend3r.isa import Table
 from rend3r.isa.tables import PROP_LIMIT
-
-from rend3r.emu import native
-from rend3r.emu.shapes import shapes_from_scene
 
 PRECISIONS = [("fp16", "ftz"), ("fp16", "ieee"), ("fp32", "ftz"), ("fp64", "ftz"), ("e6m9", "ftz"), ("e6m9", "ieee"),
               ("e5m7", "ftz"), ("bf16", "ftz")]

@@ -353,7 +353,7 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
         sb = _shadow_bounds(fr, lp, light, hits, n_pix)
         lp.tree, lp.radius = sb.bounds.struct(), address(sb.radius)
         if sb.behind is not None:
-            lp.behind, lp.keys = address(sb.behind), address(sb.keys)
+            lp.behind, lp.keys = address(sb.behind), address(sb.bounds.keys)
             lp.l_len, lp.l_hat[:] = sb.l_len, sb.l_hat
     c = _report(_run(fr.jobs, n_pix, fr.kernel("light_pass"), lp, _OUT))
     st.shadow_rays += int(c[native.OUT_SHADOW_RAYS])
@@ -377,7 +377,6 @@ class _ShadowBounds:
     radius: np.ndarray  # cull radius per shape
     bounds: bvh.Bounds  # the hierarchy's bounds for these rays
     behind: np.ndarray | None = None  # a directional light's behind terms per shape
-    keys: np.ndarray | None = None  # ... and per node the largest stop keys below it
     l_len: float = 0.0  # ... and |l| and l / |l| in double
     l_hat: np.ndarray | None = None
 
@@ -406,7 +405,7 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
     radius, behind, keys = bounds.shadow(fr.bnd, fr.bounded, lo, hi, length, *limits, unit=unit, length=length,
                                          jobs=fr.jobs)
     flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit), keys=keys)
-    return _ShadowBounds(radius, flat, behind, flat.keys, length, unit)
+    return _ShadowBounds(radius, flat, behind, length, unit)
 
 
 def _unbounded(fr: _Frame, lp: native.LightPass) -> _ShadowBounds:

@@ -242,11 +242,13 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
 
 /* The sine s and cosine of a half-angle widened by 1e-12 of s and 1e-13 (inf: every line),
  * into cs. */
+#define CONE_WIDENED(s) ((s) * (1.0 + 1e-12) + 1e-13)
+#define CONE_COS2(s) ((1.0 - (s)) * (1.0 + (s)))  /* the squared cosine of sine s */
 static inline void cone_widen(double s, double *cs)
 {
-    s = s * (1.0 + 1e-12) + 1e-13;
+    s = CONE_WIDENED(s);
     cs[0] = s < CONE_EVERY ? s : INFINITY;  /* NaN: every line */
-    cs[1] = s < CONE_EVERY ? sqrt((1.0 - s) * (1.0 + s)) : 0.0;
+    cs[1] = s < CONE_EVERY ? sqrt(CONE_COS2(s)) : 0.0;
 }
 
 /* The double cone (unit axis a1, sine and cosine cs1 of its half-angle t1) around the

@@ -100,22 +100,14 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
         bands = [(row0, min(h, row0 + rows)) for row0 in range(0, h, rows)]
         extent = _extent(fr)  # a grid camera's bands share one set of primary bounds
         primary = _primary_tree(fr, *extent) if extent is not None else None
-        if len(bands) == 1:
-            work = [(*bands[0], fr, None)]
-        else:  # bands on the threads, their work single-threaded; with a band per thread at
-            # most, this thread renders the first (rather than wait) and the pool the others
-            one = replace(fr, jobs=1)
-            own = len(bands) <= fr.jobs
-            pool = fr.jobs - 1 if own else fr.jobs
-            work = [(row0, row1, one, None if own and k == 0 else threads.submit(
-                pool, _band, one, options, row0, row1, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
-                prov[row0 * w:row1 * w], primary)) for k, (row0, row1) in enumerate(bands)]
-        for row0, row1, frame, future in work:
-            _add(st, future.result() if future is not None else _band(
-                frame, options, row0, row1, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
-                prov[row0 * w:row1 * w], primary))
-            if progress is not None:
-                progress(row1 / h)
+        # several bands: side by side on the threads, each single-threaded; one: its steps split
+        one = replace(fr, jobs=1) if len(bands) > 1 else fr
+        done = (lambda k: progress(bands[k][1] / h)) if progress is not None else None
+        for band in threads.each(fr.jobs if len(bands) > 1 else 1, [
+                lambda row0=row0, row1=row1: _band(one, options, row0, row1, rgb[row0 * w:row1 * w],
+                                                   depth[row0 * w:row1 * w], prov[row0 * w:row1 * w], primary)
+                for row0, row1 in bands], done):
+            _add(st, band)
     st.seconds = perf_counter() - start
     return Frame(number, rgb.reshape(h, w), depth.reshape(h, w), prov.reshape(h, w)), st
 

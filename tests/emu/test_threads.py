@@ -1,0 +1,51 @@
+"""The kernels' threads: the calling thread works beside its helpers; order, progress and
+errors as if the calls ran one after another."""
+
+import threading
+import time
+
+import pytest
+
+from rend3r.emu import threads
+
+
+def test_results_and_progress_come_in_order_on_the_calling_thread():
+    caller, ran, reported = threading.current_thread(), [], []
+
+    def call(k):
+        ran.append(threading.current_thread())
+        time.sleep(0.002 * (k % 3))  # calls end out of order
+        return k * k
+
+    def done(k):
+        assert threading.current_thread() is caller
+        reported.append(k)
+
+    out = threads.each(3, [lambda k=k: call(k) for k in range(12)], done)
+    assert out == [k * k for k in range(12)]
+    assert reported == list(range(12))
+    assert caller in ran  # the caller took calls itself
+    assert len(set(ran)) <= 3
+
+
+def test_an_error_stops_new_calls_and_is_raised_after_the_running_ones():
+    started, finished = [], []
+
+    def call(k):
+        started.append(k)
+        if k == 1:
+            raise ValueError("call 1")
+        time.sleep(0.01)
+        finished.append(k)
+
+    with pytest.raises(ValueError, match="call 1"):
+        threads.each(2, [lambda k=k: call(k) for k in range(50)])
+    assert len(started) < 50  # the calls after the error never started
+    assert sorted(finished) == sorted(k for k in started if k != 1)  # every call started has ended
+
+
+@pytest.mark.parametrize("jobs", [1, 2, 5])
+def test_one_call_or_one_job_runs_here(jobs):
+    here = threading.current_thread()
+    assert threads.each(jobs, [lambda: threading.current_thread()]) == [here]
+    assert threads.each(1, [lambda: threading.current_thread()] * 3) == [here] * 3

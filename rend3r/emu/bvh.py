@@ -13,12 +13,14 @@ skipping a node never changes the nearest hit.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import Rend3rError
-from . import native
+from . import native, threads
+from .bounds import SHAPE_CHUNK
 from .native import address
 
 
@@ -37,14 +39,15 @@ class Tree:
 
     def refit(self, bnd: np.ndarray, radius: np.ndarray, floor: np.ndarray | None = None, *,
               apex: np.ndarray | None = None, axes: np.ndarray | None = None,
-              keys: np.ndarray | None = None) -> Bounds:
+              keys: np.ndarray | None = None, jobs: int = 1) -> Bounds:
         """One bundle's node bounds around the balls (centre, ``radius``) of their shapes,
         and their least ``floor`` (None: -inf): the double cones around ``apex`` (lines
         through it) or the boxes on the two unit ``axes`` (2, 3) normal to parallel lines,
         with each shape's own box for parallel lines, and per node the largest of its
         shapes' stop ``keys`` (n, 3; parallel lines only). Each shape's own bound is
         computed first, four shapes at a time (csrc/shape_bounds.inc), then joined node by
-        node."""
+        node; on ``jobs`` threads when there are many shapes (the nodes' subtrees side by
+        side, then the nodes above them)."""
         n = len(bnd)
         native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
         radius = np.ascontiguousarray(radius, np.float64)
@@ -62,14 +65,37 @@ class Tree:
         frame[: 3 if apex is not None else 6] = np.ravel(apex if apex is not None else axes)
         # each shape's own cone (a scratch array) or box (kept: shadow packets test it), then the nodes'
         own = np.empty((len(self.items), native.CI_COLUMNS if apex is not None else native.BX_COLUMNS))
-        native.shape_pass("cone_items" if apex is not None else "flat_items")(
-            address(self.items), len(self.items), address(bnd), address(radius), address(frame), address(own))
+        items = native.shape_pass("cone_items" if apex is not None else "flat_items")
+        parts = threads.ranges(len(self.items), jobs, SHAPE_CHUNK)
+        threads.split(jobs, parts, lambda a, b: items(address(self.items[a:]), b - a, address(bnd), address(radius),
+                                                      address(frame), address(own[a:])))
         bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame, own if axes is not None else None,
                         None if keys is None else np.empty((self.nodes, 3)))
-        native.library().bvh_refit(bounds.struct(), None if floor is None else address(floor), kind,
-                                   address(bounds.box), address(own), None if keys is None else address(keys),
-                                   None if keys is None else address(bounds.keys))
+        refit = functools.partial(native.library().bvh_refit, bounds.struct(), None if floor is None else address(floor),
+                                  kind, address(bounds.box), address(own), None if keys is None else address(keys),
+                                  None if keys is None else address(bounds.keys))
+        below, above = self.subtrees(len(parts))
+        threads.split(jobs, below, refit)
+        for at in above:
+            refit(at, at + 1)
         return bounds
+
+    def subtrees(self, count: int) -> tuple[list[tuple[int, int]], list[int]]:
+        """The node ranges of at least ``count`` disjoint subtrees (fewer when the tree
+        has fewer leaves), largest first, and the nodes above them, children before their
+        parents. Nodes are depth first: node ``at``'s left child is ``at + 1``, its right
+        child ``node[at, 0]`` (when ``node[at, 1]``, its shape count, is 0)."""
+        below, above = [(0, self.nodes)] if self.nodes else [], []
+        while len(below) < count:
+            inner = [r for r in below if self.node[r[0], 1] == 0 and r[1] - r[0] > 1]
+            if not inner:
+                break
+            lo, hi = max(inner, key=lambda r: r[1] - r[0])
+            right = int(self.node[lo, 0])
+            below.remove((lo, hi))
+            below += [(lo + 1, right), (right, hi)]
+            above.append(lo)
+        return sorted(below, key=lambda r: r[0] - r[1]), above[::-1]
 
 
 @dataclass(frozen=True)

@@ -147,7 +147,7 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
 }
 _PLAIN = {
     "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
-    "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_int32, c_void_p, c_void_p, c_void_p, c_void_p]),
+    "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_int32, c_void_p, c_void_p, c_void_p, c_void_p, c_int64, c_int64]),
     "have_avx2": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
     "stream_scan": (None, [c_void_p, c_int64, c_int64, c_int32, c_int32, c_void_p, c_void_p, c_void_p, c_void_p,

@@ -123,14 +123,15 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     if rays.rotation is not None:  # the kernel turns (x[col], y[row], z) per pixel
         cam[native.CAM_ROT:native.CAM_ROT + 4] = [np.asarray(c, dtype) for c in rays.rotation]
     fmt = None if ar.native else native.Format.of(ar)
-    sf, si, bnd, bounded, index = _shape_tables(scene, ar, fmt, cam)
+    jobs = options.jobs or threads.available_cores()
+    sf, si, bnd, bounded, index = _shape_tables(scene, ar, fmt, cam, jobs)
     lights = lights_from_scene(scene, ar, options.light_model)
     n = len(sf)
     view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
                          native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny, fmt)
     return _Frame(ar, dtype, cam, np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype),
                   rays.rotation is not None, sf, si, index, bnd, bounded, lights,
-                  _light_rows(lights, dtype), options.jobs or threads.available_cores(), view, bvh.build(bnd, bounded))
+                  _light_rows(lights, dtype), jobs, view, bvh.build(bnd, bounded))
 
 
 #: The shape table's columns the kernels read, and the type codes of the normal forms.
@@ -140,10 +141,11 @@ _KINDS = np.array([SHAPE_TYPE_CODES["sphere"], SHAPE_TYPE_CODES["cylinder"], SHA
                    lookup(Table.SHAPE, "type").value_mask], np.int32)
 
 
-def _shape_tables(scene: Scene, ar: Arith, fmt, cam: np.ndarray) -> tuple[np.ndarray, ...]:
+def _shape_tables(scene: Scene, ar: Arith, fmt, cam: np.ndarray, jobs: int) -> tuple[np.ndarray, ...]:
     """The shapes that are on, as the kernels' tables (csrc/datapath.inc shape_tables, with
     the camera origin ``cam`` in each shape's normal space): (floats, ints, bounds,
-    bounded, program index), in index order. Spheres with moderate
+    bounded, program index), in index order; many rows are split over ``jobs`` threads,
+    each range's shapes then moved up behind the previous range's. Spheres with moderate
     maps are bounded (culled, csrc/bounds.h) in every format: a test that overflows is a
     miss, and a format too coarse for the bounds (docs/emulator.md section 7) gets infinite
     cull radii from them."""
@@ -151,15 +153,24 @@ def _shape_tables(scene: Scene, ar: Arith, fmt, cam: np.ndarray) -> tuple[np.nda
     values = np.ascontiguousarray(table.values, np.uint16)
     index = np.ascontiguousarray(table.index, np.int64)
     rows = len(index)
+    native.ptr(values, np.uint16, (rows, PROP_LIMIT))
     sf = np.empty((rows, native.SF_COLUMNS), native.dtype(ar))  # shape_tables fills it
     si = np.empty((rows, native.SI_COLUMNS), np.int64)
     bnd = np.empty((rows, native.B_COLUMNS))
     bounded = np.empty(rows, np.uint8)
     out = np.empty(rows, np.int32)
-    n = native.kernel("shape_tables", ar)(
-        native.ptr(values, np.uint16, (rows, PROP_LIMIT)), address(index), rows, address(_SHAPE_PROPS),
-        address(_KINDS), native.ptr(cam, sf.dtype, (native.CAM_COLUMNS,)), ar.tiny, address(sf), address(si),
-        address(bnd), address(bounded), address(out), fmt)
+    tables = (sf, si, bnd, bounded, out)
+    kernel, cam_ptr = native.kernel("shape_tables", ar), native.ptr(cam, sf.dtype, (native.CAM_COLUMNS,))
+    parts = threads.ranges(rows, jobs, bounds.SHAPE_CHUNK)
+    counts = threads.each(jobs, [lambda a=a, b=b: kernel(
+        address(values[a:]), address(index[a:]), b - a, address(_SHAPE_PROPS), address(_KINDS), cam_ptr, ar.tiny,
+        *(address(t[a:]) for t in tables), fmt) for a, b in parts])
+    n = 0
+    for (a, _), count in zip(parts, counts):
+        if a != n:  # rows before a were off
+            for t in tables:
+                t[n:n + count] = t[a:a + count].copy()
+        n += count
     return sf[:n], si[:n], bnd[:n], bounded[:n].astype(bool), out[:n]
 
 
@@ -324,7 +335,7 @@ def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> _Primary:
     apex = fr.cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)  # at infinity: nothing is bounded
     radius, floor, pc = bounds.primary(fr.bnd, fr.bounded, apex, dmin, dmax, fr.ar.unit_roundoff, fr.ar.tiny,
                                        fr.ar.overflow, fr.jobs)
-    return fr.tree.refit(fr.bnd, radius, floor, apex=apex), floor, pc
+    return fr.tree.refit(fr.bnd, radius, floor, apex=apex, jobs=fr.jobs), floor, pc
 
 
 def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.ndarray, n_pix: int,
@@ -390,13 +401,13 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
         bounded = fr.bounded & bool(np.isfinite(apex).all())
         radius, _, _ = bounds.shadow(fr.bnd, bounded, lo, hi, float(origins[9]), *limits, chord=float(origins[7]),
                                      jobs=fr.jobs)
-        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex))
+        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex, jobs=fr.jobs))
     length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
         return _unbounded(fr, lp)
     radius, behind, keys = bounds.shadow(fr.bnd, fr.bounded, lo, hi, length, *limits, unit=unit, length=length,
                                          jobs=fr.jobs)
-    flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit), keys=keys)
+    flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit), keys=keys, jobs=fr.jobs)
     return _ShadowBounds(radius, flat, behind, length, unit)
 
 
@@ -404,7 +415,7 @@ def _unbounded(fr: _Frame, lp: native.LightPass) -> _ShadowBounds:
     """Bounds of infinite radii: every shadow ray tests every shape."""
     none = np.full(len(fr.sf), np.inf)
     everywhere = {"axes": np.eye(3)[:2]} if lp.parallel else {"apex": np.zeros(3)}
-    return _ShadowBounds(none, fr.tree.refit(fr.bnd, none, **everywhere))
+    return _ShadowBounds(none, fr.tree.refit(fr.bnd, none, **everywhere, jobs=fr.jobs))
 
 
 def _unit(v: np.ndarray) -> tuple[float, np.ndarray]:

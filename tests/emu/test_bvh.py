@@ -155,3 +155,34 @@ def test_refit_checks_its_arrays():
         tree.refit(bnd, np.ones(2), apex=np.zeros(3))
     with pytest.raises(ValueError):
         tree.refit(bnd, np.ones(3))
+
+
+@settings(max_examples=20, derandomize=True)
+@given(st.integers(1, 400), st.integers(0, 2**32 - 1), st.integers(2, 5))
+def test_refit_on_threads_gives_the_same_bits(n, seed, jobs):
+    """Subtrees side by side, then the nodes above them: every node's bounds and keys
+    exactly as one thread computes them, for cones and boxes (small chunks force splits)."""
+    bnd, radius, floor = shapes(n, seed)
+    keys = np.random.default_rng(seed).normal(size=(n, 3))
+    tree = bvh.build(bnd, np.ones(n, bool))
+    below, above = tree.subtrees(4 * jobs)
+    spans = sorted([(lo, hi) for lo, hi in below] + [(at, at + 1) for at in above])
+    assert [lo for lo, _ in spans] == list(np.cumsum([0] + [hi - lo for lo, hi in spans[:-1]]))
+    assert sum(hi - lo for lo, hi in spans) == tree.nodes  # disjoint, covering every node
+    for at in above:  # a node's children are refitted before it
+        first = int(tree.node[at, 0])
+        later = above[above.index(at) + 1:]
+        assert at + 1 not in later and first not in later
+    import rend3r.emu.bvh as module
+    chunk, module.SHAPE_CHUNK = module.SHAPE_CHUNK, 8
+    try:
+        for kw, columns in (({"apex": np.array([0.5, -1.0, 2.0])}, slice(None)),
+                            ({"axes": np.array([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0]]), "keys": keys},
+                             [0, 1, 2, 3, native.BV_FLOOR, *range(native.BV_FLOOR + 1, native.BV_COLUMNS)])):
+            one, many = (tree.refit(bnd, radius, floor, jobs=j, **kw) for j in (1, jobs))
+            assert one.box[:, columns].tobytes() == many.box[:, columns].tobytes()  # a box's columns
+            assert (one.keys is None) == (many.keys is None)
+            if one.keys is not None:
+                assert one.keys.tobytes() == many.keys.tobytes()
+    finally:
+        module.SHAPE_CHUNK = chunk

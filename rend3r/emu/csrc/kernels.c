@@ -320,9 +320,9 @@ static void cone_union(double *a1, double *cs1, const double *a2_, const double 
  * grow). The bounds are joined in locals (reading back the stores as a vector stalled on
  * store forwarding). */
 static void refit_flat(const Bvh *t, const double *floor, double *box, const double *items, const double *keys,
-                       double *node_keys)
+                       double *node_keys, int64_t lo, int64_t hi)
 {
-    for (int64_t at = t->nodes - 1; at >= 0; at--) {
+    for (int64_t at = hi - 1; at >= lo; at--) {
         double *b = box + BV_COLUMNS * at;
         int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
         double u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY, fl = INFINITY;
@@ -356,9 +356,10 @@ static void refit_flat(const Bvh *t, const double *floor, double *box, const dou
 
 /* bvh_refit for lines through an apex: per node the double cone holding its shapes'
  * cones, its least floor, the cone's squared sine for the tests. */
-static void refit_cones(const Bvh *t, const double *floor, double *box, const double *items)
+static void refit_cones(const Bvh *t, const double *floor, double *box, const double *items, int64_t lo,
+                        int64_t hi)
 {
-    for (int64_t at = t->nodes - 1; at >= 0; at--) {
+    for (int64_t at = hi - 1; at >= lo; at--) {
         double *b = box + BV_COLUMNS * at;
         int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
         double fl = INFINITY;
@@ -393,21 +394,25 @@ static void refit_cones(const Bvh *t, const double *floor, double *box, const do
     }
 }
 
-/* One bundle's node bounds (t->nodes x BV_COLUMNS into box) from its shapes' own bounds
- * (items, in leaf order): for BVH_CONE the double cones around the apex holding the
+/* One bundle's bounds of nodes lo..hi (BV_COLUMNS each into box) from its shapes' own
+ * bounds (items, in leaf order): for BVH_CONE the double cones around the apex holding the
  * shapes' cones (CI_COLUMNS per item, from cone_items), for parallel lines (BVH_FLAT) the
  * boxes holding the shapes' boxes (BX_COLUMNS per item, from flat_items); and each node's
  * least floor (NULL: -inf); boxes also the stop keys of a directional light's shadow rays
  * (keys NULL: none; refit_flat). Children follow their parent, so nodes go last to
- * first; a cone gets the squared sine of its half-angle (inf from CONE_EVERY on: every
- * line) for the kernels' test, a box its bounds rounded outwards to floats. */
+ * first, and lo..hi must hold the subtrees of the nodes it holds (bvh.py refits subtrees
+ * on several threads, then the nodes above them); a cone gets the squared sine of its
+ * half-angle (inf from CONE_EVERY on: every line) for the kernels' test, a box its bounds
+ * rounded outwards to floats. */
 void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items, const double *keys,
-               double *node_keys)
+               double *node_keys, int64_t lo, int64_t hi)
 {
+    if (lo < 0 || hi > t->nodes)
+        return;
     if (kind == BVH_FLAT)
-        refit_flat(t, floor, box, items, keys, node_keys);
+        refit_flat(t, floor, box, items, keys, node_keys, lo, hi);
     else
-        refit_cones(t, floor, box, items);
+        refit_cones(t, floor, box, items, lo, hi);
 }
 
 /* ---- bounds per shape (rend3r/emu/bounds.py) ---- */

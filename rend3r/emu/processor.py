@@ -32,7 +32,7 @@ from ..isa.tables import (
     DATA, FUNC, LIGHT_INDEX, OPCODE, PROP, PROP_LIMIT, SD_DATA, SD_DATA2, SE_INDEX_HI, SE_INDEX_LO, SE_PROP2,
     SHAPE_INDEX_LIMIT, Field, Func, Opcode,
 )
-from . import native
+from . import native, threads
 from .native import address
 from .options import EmuOptions
 from .scene import ObjectTable, Scene
@@ -232,24 +232,39 @@ def _marks() -> np.ndarray:
     return mark
 
 
+#: Pairs a thread takes at least (pair_marks takes about 2 ns a pair: below this, handing
+#: a range to another thread costs more than it saves).
+PAIR_CHUNK = 1 << 16
+
+
 def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, entry: int, wanted: np.ndarray,
-                 table: ObjectTable) -> None:
+                 table: ObjectTable, jobs: int) -> None:
     """Apply the SE/SD pairs at ``at`` (each writes prop then prop2; a write to a null
     property stores nothing) that ``wanted`` takes to ``table``, in compiled passes over
-    their words (csrc/kernels.c): the indices written, then the writes."""
+    their words (csrc/kernels.c): the indices written (in ranges of pairs on ``jobs``
+    threads when there are many), then the writes, in order (threads that each took a
+    range of rows spent nearly as long reading every pair as one thread writing them all)."""
     if not wanted.any():
         return
-    pairs = native.Pairs(address(words), len(words), address(at), len(at), address(_PAIR_FIELDS),
-                         None if tables is None else address(tables), entry, address(wanted),
-                         address(_SE_NULL))
+
+    def pairs(a: int, b: int) -> native.Pairs:
+        return native.Pairs(address(words), len(words), address(at[a:]), b - a, address(_PAIR_FIELDS),
+                            None if tables is None else address(tables[a:]), entry, address(wanted),
+                            address(_SE_NULL))
+
     lib, mark, top = native.library(), _marks(), -1
+    parts = threads.ranges(len(at), jobs, PAIR_CHUNK)
     try:
-        top = lib.pair_marks(byref(pairs), address(mark))
-        if top < 0:
-            raise Rend3rError(f"{_where(int(at[-1 - top]))}: an SE word without its SD")
+        tops = threads.each(jobs, [lambda a=a, b=b: lib.pair_marks(byref(pairs(a, b)), address(mark))
+                                   for a, b in parts])
+        bad = [a - 1 - t for (a, _), t in zip(parts, tops) if t < 0]  # the first pair without its SD
+        if bad:
+            raise Rend3rError(f"{_where(int(at[bad[0]]))}: an SE word without its SD")
+        top = max(tops, default=0)
         if top:
             row_of = table.grow(mark, top)
-            lib.pair_apply(byref(pairs), address(row_of), native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))
+            lib.pair_apply(byref(pairs(0, len(at))), address(row_of),
+                           native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))
     finally:  # the marks lie below the largest index written and the table's largest (grow's)
         last = int(table.index[-1]) + 1 if len(table.index) else 0
         mark[:SHAPE_INDEX_LIMIT if top < 0 else max(top, last)] = 0
@@ -307,8 +322,9 @@ def _apply(stream: _Stream, lo: int, hi: int, scene: Scene, entry: int) -> None:
     at = pairs[pairs.searchsorted(lo):pairs.searchsorted(hi)]  # hi <= stop
     if len(at):
         tables = stream.pair_tables(at)
+        jobs = stream.prog.options.jobs or threads.available_cores()
         for table, wanted in zip((scene.objects, scene.triangles), _WANTED[stream.prog.options.mode == "hybrid"]):
-            _write_pairs(stream.prog.words, at, tables, entry, wanted, table)
+            _write_pairs(stream.prog.words, at, tables, entry, wanted, table, jobs)
 
 
 def _run_pass(stream: _Stream, scene: Scene, on_nf: RenderHook | None, count: int, frames: int | None,

@@ -294,3 +294,42 @@ def test_object_table_grow_and_row():
         t.grow(np.zeros(10, np.uint8), 1)
     t.clear()
     assert len(t) == 0
+
+
+@settings(max_examples=300)
+@given(CASES, st.integers(2, 4))
+def test_pairs_split_over_threads_give_the_same_scenes(case, jobs):
+    """Ranges of pairs marked on several threads: the same executions, errors (the first
+    pair without its SD) and scenes (small ranges force splits)."""
+    from dataclasses import replace
+
+    import rend3r.emu.processor as processor
+
+    words, options, frames = case
+    chunk, processor.PAIR_CHUNK = processor.PAIR_CHUNK, 2
+    try:
+        got = _outcome(vectorized, words, replace(options, jobs=jobs), frames)
+    finally:
+        processor.PAIR_CHUNK = chunk
+    assert got == _outcome(reference, words, options, frames)
+
+
+def test_pairs_split_over_threads_keep_each_pairs_table():
+    """Hybrid mode: TS words switch tables between ranges of pairs; each range reads the
+    tables of its own pairs."""
+    from dataclasses import replace
+
+    import rend3r.emu.processor as processor
+
+    ts = [table_select_word(t) for t in (Table.SHAPE, Table.TRIANGLE)]
+    words = [NR]
+    for k in range(60):
+        words += [ts[k // 7 % 2], *encode(ShapeSet(k, 1, 2, k, k + 1))]
+    words += [NF]
+    options = EmuOptions(mode="hybrid")
+    chunk, processor.PAIR_CHUNK = processor.PAIR_CHUNK, 4
+    try:
+        got = _outcome(vectorized, words, replace(options, jobs=3), None)
+    finally:
+        processor.PAIR_CHUNK = chunk
+    assert got == _outcome(reference, words, options, None)

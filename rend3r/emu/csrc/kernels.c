@@ -510,7 +510,7 @@ static inline unsigned pair_stores(const uint8_t *wanted, const uint8_t *null, c
 }
 
 /* Marks the index of every pair taken that stores a word: mark[index] = 1 (mark holds
- * 2^19 bytes, every index). Returns the largest index marked + 1 (0 for none), or -1 - k
+ * 2^19 bytes, every index; threads may mark ranges of pairs at once). Returns the largest index marked + 1 (0 for none), or -1 - k
  * for the first pair k whose SD lies outside the words (then nothing may be written). */
 int64_t pair_marks(const Pairs *p, uint8_t *mark)
 {
@@ -529,7 +529,7 @@ int64_t pair_marks(const Pairs *p, uint8_t *mark)
         int64_t index = ((int64_t)FIELD(f, se, 0) << f.hi_shift) | FIELD(f, se, 1);
         if (index != last) {  /* as in pair_apply */
             last = index;
-            mark[index] = 1;
+            __atomic_store_n(mark + index, 1, __ATOMIC_RELAXED);  /* ranges of pairs on several threads */
             top = index >= top ? index + 1 : top;
         }
     }

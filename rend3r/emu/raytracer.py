@@ -76,7 +76,11 @@ class _Frame:
     light_rows: np.ndarray
     jobs: int
     shapes: native.Shapes
-    tree: bvh.Tree
+    built: Callable[[], bvh.Tree]  # the hierarchy, built beside the rest of the set-up
+
+    @property
+    def tree(self) -> bvh.Tree:
+        return self.built()
 
     def kernel(self, name: str):
         """The compiled kernel ``name`` for this frame's precision."""
@@ -125,13 +129,14 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     fmt = None if ar.native else native.Format.of(ar)
     jobs = options.jobs or threads.available_cores()
     sf, si, bnd, bounded, index = _shape_tables(scene, ar, fmt, cam, jobs)
+    built = threads.beside(jobs, bvh.build, bnd, bounded)  # on a helper while the primary bounds are computed
     lights = lights_from_scene(scene, ar, options.light_model)
     n = len(sf)
     view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
                          native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny, fmt)
     return _Frame(ar, dtype, cam, np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype),
                   rays.rotation is not None, sf, si, index, bnd, bounded, lights,
-                  _light_rows(lights, dtype), jobs, view, bvh.build(bnd, bounded))
+                  _light_rows(lights, dtype), jobs, view, built)
 
 
 #: The shape table's columns the kernels read, and the type codes of the normal forms.

@@ -98,6 +98,16 @@ def each(jobs: int, calls: list[Callable[[], T]], done: Callable[[int], None] | 
     return results
 
 
+def beside(jobs: int, fn: Callable[..., T], *args: object) -> Callable[[], T]:
+    """``fn(*args)`` on a helper while this thread goes on (here and now with one job);
+    returns a function that waits for its result. Calls that :func:`each` hands to the
+    busy helper wait behind it, so this thread takes them meanwhile."""
+    if jobs <= 1:
+        value = fn(*args)
+        return lambda: value
+    return _helpers(jobs - 1).submit(fn, *args).result
+
+
 def split(jobs: int, parts: list[tuple[int, int]], fn: Callable[[int, int], object]) -> None:
     """``fn(a, b)`` over the ranges ``parts`` on ``jobs`` threads."""
     each(jobs, [lambda a=a, b=b: fn(a, b) for a, b in parts])

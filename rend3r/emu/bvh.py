@@ -121,7 +121,7 @@ def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
     ``bounded`` with a finite centre; the others go to the list every ray tests."""
     n = len(bnd)
     native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
-    ok = np.ascontiguousarray(bounded, bool).view(np.uint8)
+    ok = np.ascontiguousarray(bounded, np.uint8)  # 0 or 1 (bool or uint8 given)
     native.ptr(ok, np.uint8, (n,))
     items, always, node = np.empty(n, np.int32), np.empty(n, np.int32), np.empty((max(1, 2 * n), 2), np.int32)
     counts = np.zeros(2, np.int64)

@@ -71,7 +71,7 @@ class _Frame:
     si: np.ndarray
     index: np.ndarray
     bnd: np.ndarray
-    bounded: np.ndarray
+    bounded: np.ndarray  # uint8, 1 where the shape is bounded
     lights: list[Light]
     light_rows: np.ndarray
     jobs: int
@@ -176,7 +176,7 @@ def _shape_tables(scene: Scene, ar: Arith, fmt, cam: np.ndarray, jobs: int) -> t
             for t in tables:
                 t[n:n + count] = t[a:a + count].copy()
         n += count
-    return sf[:n], si[:n], bnd[:n], bounded[:n].astype(bool), out[:n]
+    return sf[:n], si[:n], bnd[:n], bounded[:n], out[:n]
 
 
 @dataclass(frozen=True)
@@ -327,11 +327,13 @@ def _extent(fr: _Frame) -> tuple[float, float] | None:
     directions are (x[col], y[row], z), all finite and z not zero; None for other cameras
     (each band measures its directions as the kernels compute them)."""
     z = float(fr.cam[native.CAM_Z])
-    xs, ys = fr.xs.astype(np.float64), fr.ys.astype(np.float64)
-    if fr.rotated or not (z != 0 and np.isfinite(z) and np.isfinite(xs).all() and np.isfinite(ys).all()):
+    if fr.rotated or not (z != 0 and math.isfinite(z)):
         return None
-    return (float(np.sqrt(np.min(xs**2) + np.min(ys**2) + z * z)),
-            float(np.sqrt(np.max(xs**2) + np.max(ys**2) + z * z)))
+    xx, yy = np.square(fr.xs, dtype=np.float64), np.square(fr.ys, dtype=np.float64)
+    x0, x1, y0, y1 = float(xx.min()), float(xx.max()), float(yy.min()), float(yy.max())
+    if not (math.isfinite(x1) and math.isfinite(y1)):  # an infinite or NaN direction (NaN propagates)
+        return None
+    return math.sqrt(x0 + y0 + z * z), math.sqrt(x1 + y1 + z * z)
 
 
 def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> _Primary:

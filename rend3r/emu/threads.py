@@ -88,11 +88,15 @@ def each(jobs: int, calls: list[Callable[[], T]], done: Callable[[int], None] | 
     futures = [_helpers(jobs - 1).submit(drain) for _ in range(min(jobs, len(calls)) - 1)]
     try:
         drain()
-    finally:  # the helpers' calls may write into the caller's arrays: wait for them
+    finally:  # the helpers' calls may write into the caller's arrays: wait for them. A helper
+        # that has not started has nothing left to take (and may never start, when the
+        # caller is itself a helper): it is cancelled
         for future in futures:
-            future.exception()
+            if not future.cancel():
+                future.exception()
     for future in futures:
-        future.result()
+        if not future.cancelled():
+            future.result()
     if done is not None:
         report()
     return results

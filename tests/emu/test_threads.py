@@ -1,6 +1,8 @@
 """The kernels' threads: the calling thread works beside its helpers; order, progress and
 errors as if the calls ran one after another."""
 
+import subprocess
+import sys
 import threading
 import time
 
@@ -49,3 +51,13 @@ def test_one_call_or_one_job_runs_here(jobs):
     here = threading.current_thread()
     assert threads.each(jobs, [lambda: threading.current_thread()]) == [here]
     assert threads.each(1, [lambda: threading.current_thread()] * 3) == [here] * 3
+
+
+def test_work_handed_out_from_a_helper_does_not_wait_for_itself():
+    """A call that itself splits work over the threads (its helpers may all be busy,
+    running it): the caller takes every call, and helpers that never started are dropped.
+    In a process of its own, as a helper that waited for itself would hang this one."""
+    code = ("from rend3r.emu import threads\n"
+            "inner = lambda: threads.each(2, [lambda k=k: k for k in range(6)])\n"
+            "assert threads.each(2, [inner, inner]) == [list(range(6))] * 2\n")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=30)

@@ -510,8 +510,9 @@ static inline unsigned pair_stores(const uint8_t *wanted, const uint8_t *null, c
 }
 
 /* Marks the index of every pair taken that stores a word: mark[index] = 1 (mark holds
- * 2^19 bytes, every index; threads may mark ranges of pairs at once). Returns the largest index marked + 1 (0 for none), or -1 - k
- * for the first pair k whose SD lies outside the words (then nothing may be written). */
+ * 2^19 bytes, every index; threads may mark ranges of pairs at once). Returns the largest
+ * index marked + 1 (0 for none), or -1 - k for the first pair k whose SD lies outside the
+ * words (then nothing may be written). */
 int64_t pair_marks(const Pairs *p, uint8_t *mark)
 {
     const uint32_t *words = p->words;

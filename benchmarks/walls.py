@@ -50,6 +50,7 @@ FAR = 4.0  # the last one (radius <= 8: see above)
 SHRINK = 0.3  # the hidden spheres' angular radius, of the front sphere's
 BAND = 2  # pixels either side of a silhouette where float16 may differ from fp64
 LIGHT = (-0.3, -0.4, -1.0)  # the direction the light travels (REND3R's forward vector)
+POINT_LIGHT = (3.0, 4.0, 10.0)  # a point light's place: up, right and behind the eye, lighting the same faces
 
 
 @dataclass(frozen=True)
@@ -78,8 +79,10 @@ def _prop(table: Table, name: str) -> int:
     return lookup(table, name).index
 
 
-def wall(n: int, lights: int = 1) -> Wall:
-    """The ``n``-sphere scene (a key of LAYOUT), with 0 or 1 lights."""
+def wall(n: int, lights: int = 1, point: bool = False) -> Wall:
+    """The ``n``-sphere scene (a key of LAYOUT), with 0 or 1 lights: directional, or a point
+    light at POINT_LIGHT (its shadow rays head back past the eye; the hidden spheres lie
+    behind every origin, along the rays' lines)."""
     k, depth = LAYOUT[n]
     spacing = 10 * FOV * DISTANCE / k
     i, j, d = (a.ravel() for a in np.meshgrid(np.arange(k), np.arange(k), np.arange(depth), indexing="ij"))
@@ -94,8 +97,9 @@ def wall(n: int, lights: int = 1) -> Wall:
     for name, value in (("rrot", 1.0), ("hfov", FOV), ("vfov", FOV), ("nclip", NEAR[k])):
         words += encode(CameraSet(_prop(Table.CAMERA, name), float_to_bits(value)))
     if lights:
-        for name, value in (("src", 1), ("xfor", float_to_bits(LIGHT[0])), ("yfor", float_to_bits(LIGHT[1])),
-                            ("zfor", float_to_bits(LIGHT[2])), ("col", 0xFFFF), ("int", float_to_bits(1.0))):
+        place = (("src", 2), *((n, float_to_bits(v)) for n, v in zip(("xloc", "yloc", "zloc"), POINT_LIGHT)))
+        aim = (("src", 1), *((n, float_to_bits(v)) for n, v in zip(("xfor", "yfor", "zfor"), LIGHT)))
+        for name, value in (*(place if point else aim), ("col", 0xFFFF), ("int", float_to_bits(1.0))):
             words += encode(LightSet(0, _prop(Table.LIGHT, name), value))
     p = lambda name: _prop(Table.SHAPE, name)  # noqa: E731
     for s, (c, col, v) in enumerate(zip(centers, rgb565, inv)):

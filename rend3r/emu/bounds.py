@@ -49,8 +49,9 @@ def shadow(table: np.ndarray, ok: np.ndarray, lo: np.ndarray, hi: np.ndarray, dm
     point light, by ``chord`` (the largest turn of a rounded l off the line to the light);
     for a directional light along the unit vector ``unit`` (|l| = ``length``), also the
     behind terms and stop keys (n, 3 each) of the light pass's per-packet test
-    (``csrc/kernels.h`` LightPass.behind, ``csrc/shape_bounds.inc`` shadow_shapes), else
-    None and None."""
+    (``csrc/kernels.h`` LightPass.behind, ``csrc/shape_bounds.inc`` shadow_shapes); for a
+    point light (``chord`` given) None and the terms of its per-node behind test (n,
+    SK_COLUMNS: ``csrc/cull.h`` point_behind4); else None and None."""
     n = len(table)
     table, flags = _inputs(table, ok)
     lo3, hi3 = [float(c) for c in lo], [float(c) for c in hi]  # 3-vectors: plain arithmetic
@@ -62,12 +63,14 @@ def shadow(table: np.ndarray, ok: np.ndarray, lo: np.ndarray, hi: np.ndarray, dm
         native.ptr(unit, np.float64, (3,))
     radius = np.empty(n)
     behind, keys = (None, None) if unit is None else (np.empty((n, 3)), np.empty((n, 3)))
+    point = np.empty((n, native.SK_COLUMNS)) if unit is None and chord == chord else None
     kernel = native.shape_pass("shadow_shapes")
     threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: kernel(
         address(table[a:]), address(flags[a:]), b - a, address(mid), half, magnitude, dmin, chord, u, tiny,
         overflow, None if unit is None else address(unit), length, address(radius[a:]),
-        None if behind is None else address(behind[a:]), None if keys is None else address(keys[a:])))
-    return radius, behind, keys
+        None if behind is None else address(behind[a:]), None if keys is None else address(keys[a:]),
+        None if point is None else address(point[a:])))
+    return radius, behind, keys if point is None else point
 
 
 def _inputs(table: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -44,7 +44,9 @@ class Tree:
         and their least ``floor`` (None: -inf): the double cones around ``apex`` (lines
         through it) or the boxes on the two unit ``axes`` (2, 3) normal to parallel lines,
         with each shape's own box for parallel lines, and per node the largest of its
-        shapes' stop ``keys`` (n, 3; parallel lines only). Each shape's own bound is
+        shapes' stop ``keys`` (n, 3; parallel lines) or the joined terms of a point light's
+        behind test (``keys`` n x SK_COLUMNS, per node PK_COLUMNS; lines through the apex,
+        ``csrc/kernels.c`` refit_cones). Each shape's own bound is
         computed first, four shapes at a time (csrc/shape_bounds.inc), then joined node by
         node; on ``jobs`` threads when there are many shapes (the nodes' subtrees side by
         side, then the nodes above them)."""
@@ -56,10 +58,8 @@ class Tree:
             native.ptr(floor, np.float64, (n,))
         if (apex is None) == (axes is None):
             raise ValueError("refit: give the apex of the lines or the axes normal to them")
-        if keys is not None:
-            if axes is None:
-                raise ValueError("refit: stop keys are for parallel lines")
-            native.ptr(keys, np.float64, (n, 3))
+        if keys is not None:  # parallel lines' stop keys, or a point light's behind terms
+            native.ptr(keys, np.float64, (n, 3 if axes is not None else native.SK_COLUMNS))
         kind = native.BVH_CONE if apex is not None else native.BVH_FLAT
         frame = np.zeros(6)
         frame[: 3 if apex is not None else 6] = np.ravel(apex if apex is not None else axes)
@@ -70,7 +70,7 @@ class Tree:
         threads.split(jobs, parts, lambda a, b: items(address(self.items[a:]), b - a, address(bnd), address(radius),
                                                       address(frame), address(own[a:])))
         bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame, own if axes is not None else None,
-                        None if keys is None else np.empty((self.nodes, 3)))
+                        None if keys is None else np.empty((self.nodes, 3 if axes is not None else native.PK_COLUMNS)))
         refit = functools.partial(native.library().bvh_refit, bounds.struct(), None if floor is None else address(floor),
                                   kind, address(bounds.box), address(own), None if keys is None else address(keys),
                                   None if keys is None else address(bounds.keys))
@@ -106,7 +106,7 @@ class Bounds:
     box: np.ndarray  # (nodes, BV_COLUMNS) float64
     frame: np.ndarray  # 6 float64
     item_box: np.ndarray | None = None  # parallel lines: (items, BX_COLUMNS), each shape's own box
-    keys: np.ndarray | None = None  # parallel lines with stop keys: (nodes, 3), the largest below each node
+    keys: np.ndarray | None = None  # stop keys (nodes, 3) or a point light's terms (nodes, PK_COLUMNS)
 
     def struct(self) -> native.Bvh:
         """The kernels' view (the arrays must outlive it)."""

@@ -40,6 +40,7 @@ BVH_CONE, BVH_FLAT = 0, 1  # a hierarchy's bounds around lines through one apex,
 BV_SINE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 5, 6, 12  # their columns (csrc/kernels.h)
 BX_COLUMNS = 8  # a shape's own box on the axes normal to parallel lines (and rounded to floats)
 CI_COLUMNS = 5  # a shape's own cone around an apex: unit axis, sine and cosine of its half-angle
+SK_COLUMNS, PK_COLUMNS = 6, 9  # a point light's behind terms per shape and per node (csrc/kernels.h)
 
 
 class Format(Structure):
@@ -99,7 +100,8 @@ class LightPass(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("band", POINTER(Band)), ("light", c_void_p), ("scale", c_double * 3),
                 ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
                 ("first", c_int32), ("last", c_int32), ("behind", c_void_p),
-                ("l_hat", c_double * 3), ("l_len", c_double), ("radius", c_void_p), ("tree", Bvh), ("keys", c_void_p)]
+                ("l_hat", c_double * 3), ("l_len", c_double), ("radius", c_void_p), ("tree", Bvh), ("keys", c_void_p),
+                ("point_keys", c_void_p)]
 
 
 #: Pixels a band may hold and the widest frame, for Band.row_magic (csrc/kernels.h band_row).
@@ -160,7 +162,7 @@ _PER_ISA = {  # name: (restype, argtypes); each exists once per instruction set 
     "primary_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,
                               c_void_p, c_void_p, c_void_p]),
     "shadow_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,
-                             c_double, c_double, c_void_p, c_double, c_void_p, c_void_p, c_void_p]),
+                             c_double, c_double, c_void_p, c_double, c_void_p, c_void_p, c_void_p, c_void_p]),
     "flat_items": (None, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
     "cone_items": (None, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
 }

@@ -362,6 +362,8 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
     if shadows:  # lp points into the arrays of sb: they live until the pass is done
         sb = _shadow_bounds(fr, lp, light, hits, n_pix)
         lp.tree, lp.radius = sb.bounds.struct(), address(sb.radius)
+        if point and sb.bounds.keys is not None:  # the terms of its per-node behind test
+            lp.point_keys = address(sb.bounds.keys)
         if sb.behind is not None:
             lp.behind, lp.keys = address(sb.behind), address(sb.bounds.keys)
             lp.l_len, lp.l_hat[:] = sb.l_len, sb.l_hat
@@ -406,9 +408,9 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
         if not origins[8]:
             return _unbounded(fr, lp)
         bounded = fr.bounded & bool(np.isfinite(apex).all())
-        radius, _, _ = bounds.shadow(fr.bnd, bounded, lo, hi, float(origins[9]), *limits, chord=float(origins[7]),
-                                     jobs=fr.jobs)
-        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex, jobs=fr.jobs))
+        radius, _, terms = bounds.shadow(fr.bnd, bounded, lo, hi, float(origins[9]), *limits,
+                                         chord=float(origins[7]), jobs=fr.jobs)
+        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex, keys=terms, jobs=fr.jobs))
     length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
         return _unbounded(fr, lp)

@@ -186,3 +186,26 @@ def test_refit_on_threads_gives_the_same_bits(n, seed, jobs):
                 assert one.keys.tobytes() == many.keys.tobytes()
     finally:
         module.SHAPE_CHUNK = chunk
+
+
+@settings(max_examples=30, derandomize=True)
+@given(st.integers(1, 300), st.integers(0, 2**32 - 1))
+def test_point_light_terms_hold_every_shape_below(n, seed):
+    """Per node, a point light's behind-test terms (csrc/kernels.c refit_cones): the box
+    holds every centre below, the least mean2 and the largest K and radius bound every
+    shape's; a NaN K becomes inf, which claims nothing."""
+    bnd, radius, _ = shapes(n, seed)
+    rng = np.random.default_rng(seed)
+    terms = np.empty((n, native.SK_COLUMNS))
+    terms[:, :3] = bnd[:, :3]
+    terms[:, 3], terms[:, 4], terms[:, 5] = rng.random(n) + 0.1, rng.random(n), radius
+    terms[rng.random(n) < 0.05, 4] = np.nan  # K
+    tree = bvh.build(bnd, np.ones(n, bool))
+    keys = tree.refit(bnd, radius, apex=np.array([0.5, -1.0, 2.0]), keys=terms).keys
+    assert keys.shape == (tree.nodes, native.PK_COLUMNS)
+    for at, below in leaves(tree):
+        k, t = keys[at], terms[below]
+        assert (k[0:3] <= t[:, :3]).all() and (k[3:6] >= t[:, :3]).all()
+        assert k[6] == t[:, 3].min()
+        assert k[7] == (np.inf if np.isnan(t[:, 4]).any() else t[:, 4].max())
+        assert k[8] == t[:, 5].max()

@@ -68,4 +68,40 @@ INLINE i64x4 misses4(const double *b, double r, f64x4 o0, f64x4 o1, f64x4 o2, f6
     return off | behind;
 }
 
+/* Shadow rays P + t l towards a point light against every shape below a node, from the
+ * node's terms pk (PK_COLUMNS, kernels.c refit_cones): the lanes for which misses4's
+ * behind test holds for each of them, so none can block them. For a centre c in the box
+ * (lo, hi): (P - c).l >= P.l - max over the box of c.l =: x, and |P - c| lies between the
+ * box's distance from P, n, and its farthest corner's, f; so with the node's least mean2
+ * m, largest K and largest radius R, mean2_c (P - c).l - K_c |l| |P - c| >=
+ * m x - K |l| f (once x >= 0), and P lies outside c's cull radius when n > R
+ * (docs/emulator.md 7.1). In double, x is lowered by 1e-12 of its terms' magnitudes, f
+ * raised and n lowered by 1e-12, and the two products moved by 1e-12 the safe way, far
+ * beyond double rounding; the box's NaN, mean2 0 or an infinite K or R claim nothing,
+ * nor does a lane with NaN or infinity (pl = P.l in double). */
+INLINE i64x4 point_behind4(const double *pk, f64x4 p0, f64x4 p1, f64x4 p2, f64x4 l0, f64x4 l1, f64x4 l2, f64x4 pl)
+{
+    const double *lo = pk + PK_LO, *hi = pk + PK_HI;
+    i64x4 none = {0, 0, 0, 0};
+    if (!(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2] && pk[PK_MEAN2] > 0 && pk[PK_K] < INFINITY
+          && pk[PK_R] < INFINITY))
+        return none;
+    f64x4 cl = max4(l0 * lo[0], l0 * hi[0]) + max4(l1 * lo[1], l1 * hi[1]) + max4(l2 * lo[2], l2 * hi[2]);
+    if (!mask_bits_64x4(pl - cl > 0))  /* no lane ahead of the box: the usual case, settled early */
+        return none;
+    f64x4 mag = abs4(p0 * l0) + abs4(p1 * l1) + abs4(p2 * l2) + abs4(l0) * MAX(fabs(lo[0]), fabs(hi[0]))
+                + abs4(l1) * MAX(fabs(lo[1]), fabs(hi[1])) + abs4(l2) * MAX(fabs(lo[2]), fabs(hi[2]));
+    f64x4 x = pl - cl - 1e-12 * mag;
+    f64x4 f0 = max4(abs4(p0 - lo[0]), abs4(p0 - hi[0])), f1 = max4(abs4(p1 - lo[1]), abs4(p1 - hi[1]));
+    f64x4 f2 = max4(abs4(p2 - lo[2]), abs4(p2 - hi[2]));
+    f64x4 zero = {0, 0, 0, 0};
+    f64x4 n0 = max4(max4(lo[0] - p0, p0 - hi[0]), zero), n1 = max4(max4(lo[1] - p1, p1 - hi[1]), zero);
+    f64x4 n2 = max4(max4(lo[2] - p2, p2 - hi[2]), zero);
+    f64x4 far = sqrt4(f0 * f0 + f1 * f1 + f2 * f2) * (1.0 + 1e-12);
+    f64x4 near = sqrt4(n0 * n0 + n1 * n1 + n2 * n2) * (1.0 - 1e-12);
+    f64x4 ll = sqrt4(l0 * l0 + l1 * l1 + l2 * l2);
+    f64x4 ahead = pk[PK_MEAN2] * x * (1.0 - 1e-12) - pk[PK_K] * ll * far * (1.0 + 1e-12);
+    return (near > pk[PK_R]) & (ahead > 0.015625 * (1.0 + 1e-9)) & (x > 0);
+}
+
 #endif

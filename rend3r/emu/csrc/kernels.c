@@ -354,15 +354,36 @@ static void refit_flat(const Bvh *t, const double *floor, double *box, const dou
     }
 }
 
+/* A point light's behind-test terms of a node (PK_COLUMNS) joined with those of a shape
+ * (SK_COLUMNS, shape) or of a child node: the box of the centres, the least mean2, the
+ * largest K and radius. A NaN makes the node's terms claim nothing: the box stays NaN,
+ * mean2 becomes 0, K and the radius inf. */
+static inline void point_join(double *pk, const double *e, int shape)
+{
+    const double *c = e + (shape ? SK_CENTER : PK_LO), *h = e + (shape ? SK_CENTER : PK_HI);
+    for (int k = 0; k < 3; k++) {  /* a NaN stays */
+        double a = pk[PK_LO + k], z = pk[PK_HI + k];
+        pk[PK_LO + k] = a != a || c[k] != c[k] ? NAN : MIN(a, c[k]);
+        pk[PK_HI + k] = z != z || h[k] != h[k] ? NAN : MAX(z, h[k]);
+    }
+    double m = e[shape ? SK_MEAN2 : PK_MEAN2], kk = e[shape ? SK_K : PK_K], r = e[shape ? SK_R : PK_R];
+    pk[PK_MEAN2] = m >= pk[PK_MEAN2] ? pk[PK_MEAN2] : m == m ? m : 0.0;
+    pk[PK_K] = kk <= pk[PK_K] ? pk[PK_K] : kk == kk ? kk : INFINITY;
+    pk[PK_R] = r <= pk[PK_R] ? pk[PK_R] : r == r ? r : INFINITY;
+}
+
 /* bvh_refit for lines through an apex: per node the double cone holding its shapes'
- * cones, its least floor, the cone's squared sine for the tests. */
-static void refit_cones(const Bvh *t, const double *floor, double *box, const double *items, int64_t lo,
-                        int64_t hi)
+ * cones, its least floor, the cone's squared sine for the tests, and where keys is not
+ * NULL (a point light's shadow rays: SK_COLUMNS per shape) its behind-test terms
+ * (PK_COLUMNS per node into node_keys). */
+static void refit_cones(const Bvh *t, const double *floor, double *box, const double *items, const double *keys,
+                        double *node_keys, int64_t lo, int64_t hi)
 {
     for (int64_t at = hi - 1; at >= lo; at--) {
         double *b = box + BV_COLUMNS * at;
         int32_t first = t->node[2 * at], count = t->node[2 * at + 1];
         double fl = INFINITY;
+        double pk[PK_COLUMNS] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY, INFINITY, 0.0, 0.0};
         if (count == 0) {
             const double *l = box + BV_COLUMNS * (at + 1), *r = box + BV_COLUMNS * (int64_t)first;
             memcpy(b + BV_AXIS, l + BV_AXIS, 3 * sizeof(double));
@@ -370,10 +391,16 @@ static void refit_cones(const Bvh *t, const double *floor, double *box, const do
             b[BV_COS] = l[BV_COS];
             cone_union(b + BV_AXIS, b + BV_SINE, r + BV_AXIS, r + BV_SINE);
             fl = MIN(l[BV_FLOOR], r[BV_FLOOR]);
+            if (keys != NULL) {
+                point_join(pk, node_keys + PK_COLUMNS * (at + 1), 0);
+                point_join(pk, node_keys + PK_COLUMNS * (int64_t)first, 0);
+            }
         }
         for (int32_t i = first; count > 0 && i < first + count; i++) {
             const double *o = items + CI_COLUMNS * (int64_t)i;  /* the shape's own cone (cone_items) */
             fl = MIN(fl, floor != NULL ? floor[t->items[i]] : -INFINITY);
+            if (keys != NULL)
+                point_join(pk, keys + SK_COLUMNS * (int64_t)t->items[i], 1);
             if (i == first) {
                 memcpy(b + BV_AXIS, o, 3 * sizeof(double));
                 b[BV_SINE] = o[CI_SINE];
@@ -391,6 +418,8 @@ static void refit_cones(const Bvh *t, const double *floor, double *box, const do
             b[BV_AXIS32 + c] = (float)b[BV_AXIS + c];
         b[BV_SIN2_32] = cone ? ceil32((sine * (1.0 + 1e-9) + 8 * U32) * (sine * (1.0 + 1e-9) + 8 * U32)
                                       * (1.0 + 10 * U32)) : INFINITY;
+        if (keys != NULL)
+            memcpy(node_keys + PK_COLUMNS * at, pk, sizeof pk);
     }
 }
 
@@ -399,7 +428,8 @@ static void refit_cones(const Bvh *t, const double *floor, double *box, const do
  * shapes' cones (CI_COLUMNS per item, from cone_items), for parallel lines (BVH_FLAT) the
  * boxes holding the shapes' boxes (BX_COLUMNS per item, from flat_items); and each node's
  * least floor (NULL: -inf); boxes also the stop keys of a directional light's shadow rays
- * (keys NULL: none; refit_flat). Children follow their parent, so nodes go last to
+ * (keys NULL: none; refit_flat), cones a point light's behind-test terms (refit_cones).
+ * Children follow their parent, so nodes go last to
  * first, and lo..hi must hold the subtrees of the nodes it holds (bvh.py refits subtrees
  * on several threads, then the nodes above them); a cone gets the squared sine of its
  * half-angle (inf from CONE_EVERY on: every line) for the kernels' test, a box its bounds
@@ -412,7 +442,7 @@ void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, con
     if (kind == BVH_FLAT)
         refit_flat(t, floor, box, items, keys, node_keys, lo, hi);
     else
-        refit_cones(t, floor, box, items, lo, hi);
+        refit_cones(t, floor, box, items, keys, node_keys, lo, hi);
 }
 
 /* ---- bounds per shape (rend3r/emu/bounds.py) ---- */

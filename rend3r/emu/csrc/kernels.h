@@ -80,6 +80,12 @@ enum { BX_BOX32 = 4, BX_COLUMNS = 8 };
  * half-angle: sine inf for every line), per item in leaf order, while the nodes' cones
  * are fitted (kernels.c bvh_refit). */
 enum { CI_SINE = 3, CI_COS = 4, CI_COLUMNS = 5 };
+/* A point light's behind test (cull.h point_behind4): per shape its centre, mean2, the
+ * behind test's K (spread2 + 64 uu smax^2) and its cull radius (shape_bounds.inc
+ * shadow_shapes), and per node the box of the centres below it, the least mean2 and the
+ * largest K and radius (kernels.c refit_cones). */
+enum { SK_CENTER = 0, SK_MEAN2 = 3, SK_K = 4, SK_R = 5, SK_COLUMNS = 6 };
+enum { PK_LO = 0, PK_HI = 3, PK_MEAN2 = 6, PK_K = 7, PK_R = 8, PK_COLUMNS = 9 };
 
 typedef struct {
     const int32_t *node;    /* per node: right child (inner) or first item (leaf), item count (0: inner);
@@ -139,6 +145,8 @@ typedef struct {            /* one light over one band */
     Bvh tree;               /* the shapes, with these shadow rays' boxes */
     const double *keys;     /* directional light (else NULL): per node the largest stop keys below it
                                (shape_bounds.inc shadow_shapes, kernels.c bvh_refit) */
+    const double *point_keys; /* point light (else NULL): per node PK_COLUMNS, its shapes' behind
+                                 test's terms (cull.h point_behind4) */
 } LightPass;
 
 /* The row within its band of pixel p: (p * row_magic) >> 40 equals p / width exactly for

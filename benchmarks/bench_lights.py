@@ -15,28 +15,15 @@ frames must show the same shapes (exit 1 if not: the light changes colours only)
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
-import time
 
 import walls
+from bench_raytrace import measure
 
 from rend3r.emu.options import EmuOptions
-from rend3r.emu.run import RunResult, run_program
 from rend3r.memory import reuse_freed_memory
 
 WIDTH, HEIGHT = 512, 384
-
-
-def timed(words, options: EmuOptions, runs: int) -> tuple[float, RunResult]:
-    """Median seconds of ``runs`` whole runs after one untimed, and the last result."""
-    result = run_program(words, options)
-    times = []
-    for _ in range(runs):
-        start = time.perf_counter()
-        result = run_program(words, options)
-        times.append(time.perf_counter() - start)
-    return statistics.median(times), result
 
 
 def main() -> int:
@@ -52,8 +39,8 @@ def main() -> int:
     print(f"{'spheres':>8} {'directional':>12} {'point':>10} {'point / dir':>12} {'shadow rays (point)':>20}")
     same = True
     for n in args.sizes:
-        directional, d = timed(walls.wall(n, 1).words, options, args.runs)
-        point, p = timed(walls.wall(n, 1, point=True).words, options, args.runs)
+        directional, d = measure(walls.wall(n, 1).words, options, args.runs)
+        point, p = measure(walls.wall(n, 1, point=True).words, options, args.runs)
         same &= bool((d.frames[0].provenance == p.frames[0].provenance).all())
         print(f"{n:>8,} {directional * 1e3:>10.2f}ms {point * 1e3:>8.2f}ms {point / directional:>11.2f}x "
               f"{p.stats.frames[0].shadow_rays:>20,}", flush=True)

@@ -238,12 +238,26 @@ def test_neighbours_shadowing_each_other(g, k, fill, distance, lit, stretch, rot
     """A directional light's packets of one receiver test only that receiver's casters
     (csrc/casters.h): close walls of stretched, turned spheres under a grazing light, where
     neighbours block shadow rays (counted in the reference), render as the reference does."""
+    cam, shapes = _columns(g, k, fill, distance, stretch, rot, 0.1)
+    options = EmuOptions(precision=prec[0], subnormals=prec[1], width=32, height=24)
+    _check_counting_blocked(program(cam, [lit], shapes, [], options), options)
+
+
+def _columns(g: int, k: int, fill: float, distance: float, stretch: tuple, rot: tuple,
+             step: float) -> tuple[dict, list[dict]]:
+    """The eye at the origin looking along -z, and g x g columns k deep of stretched,
+    turned spheres filling ``fill`` of their spacing, ``distance`` away, each layer
+    ``step`` of it behind the one before."""
     cam = {"xloc": 0, "yloc": 0, "zloc": 0, "rot": (0, 0, 0, 0), "hfov": float_to_bits(0.4),
            "vfov": float_to_bits(0.4), "nclip": 0, "fclip": 0}
     shapes = [{"type": 1, "col": 0x0841 * (i + 1) & 0xFFFF, "rot": rot, "stretch": stretch, "special": None,
                "aim": (0.5 + ((i % g) - (g - 1) / 2) / (g + 1), 0.5 + ((i // g % g) - (g - 1) / 2) / (g + 1),
-                       distance * (1 + 0.1 * (i // (g * g))), fill / (g + 1))} for i in range(g * g * k)]
-    options = EmuOptions(precision=prec[0], subnormals=prec[1], width=32, height=24)
+                       distance * (1 + step * (i // (g * g))), fill / (g + 1))} for i in range(g * g * k)]
+    return cam, shapes
+
+
+def _check_counting_blocked(words: list[int], options: EmuOptions) -> None:
+    """check(), reporting whether the reference found shadow rays blocked."""
     blocked, plain = [], reference._blocked
 
     def counted(*args):
@@ -253,7 +267,7 @@ def test_neighbours_shadowing_each_other(g, k, fill, distance, lit, stretch, rot
 
     reference._blocked = counted
     try:
-        check(program(cam, [lit], shapes, [], options), options)
+        check(words, options)
     finally:
         reference._blocked = plain
     event(f"shadowed points: {'none' if not sum(blocked) else 'some'}")
@@ -293,22 +307,6 @@ def test_point_light_among_columns(g, k, fill, distance, at, stretch, rot, prec)
     light = {"src": 2, "col": 0xFFFF, "int": float_to_bits(1.0),
              **{n: float_to_bits(v) for n, v in zip(("xloc", "yloc", "zloc"),
                                                      (at[0] * distance, at[1] * distance, -at[2] * depth))}}
-    cam = {"xloc": 0, "yloc": 0, "zloc": 0, "rot": (0, 0, 0, 0), "hfov": float_to_bits(0.4),
-           "vfov": float_to_bits(0.4), "nclip": 0, "fclip": 0}
-    shapes = [{"type": 1, "col": 0x0841 * (i + 1) & 0xFFFF, "rot": rot, "stretch": stretch, "special": None,
-               "aim": (0.5 + ((i % g) - (g - 1) / 2) / (g + 1), 0.5 + ((i // g % g) - (g - 1) / 2) / (g + 1),
-                       distance * (1 + 0.12 * (i // (g * g))), fill / (g + 1))} for i in range(g * g * k)]
+    cam, shapes = _columns(g, k, fill, distance, stretch, rot, 0.12)
     options = EmuOptions(precision=prec[0], subnormals=prec[1], width=32, height=24)
-    blocked, plain = [], reference._blocked
-
-    def counted(*args):
-        out = plain(*args)
-        blocked.append(int(out.sum()))
-        return out
-
-    reference._blocked = counted
-    try:
-        check(program(cam, [light], shapes, [], options), options)
-    finally:
-        reference._blocked = plain
-    event(f"shadowed points: {'none' if not sum(blocked) else 'some'}")
+    _check_counting_blocked(program(cam, [light], shapes, [], options), options)

@@ -71,8 +71,9 @@ class Tree:
                                                       address(frame), address(own[a:])))
         bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame, own if axes is not None else None,
                         None if keys is None else np.empty((self.nodes, 3 if axes is not None else native.PK_COLUMNS)))
-        refit = functools.partial(native.library().bvh_refit, bounds.struct(), None if floor is None else address(floor),
-                                  kind, address(bounds.box), address(own), None if keys is None else address(keys),
+        refit = functools.partial(native.library().bvh_refit, bounds.struct(),
+                                  None if floor is None else address(floor), kind, address(bounds.box), address(own),
+                                  None if keys is None else address(keys),
                                   None if keys is None else address(bounds.keys))
         below, above = self.subtrees(len(parts))
         threads.split(jobs, below, refit)

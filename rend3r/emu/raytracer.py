@@ -174,7 +174,7 @@ def _shape_tables(scene: Scene, ar: Arith, fmt, cam: np.ndarray, jobs: int) -> t
     for (a, _), count in zip(parts, counts):
         if a != n:  # rows before a were off
             for t in tables:
-                t[n:n + count] = t[a:a + count].copy()
+                t[n:n + count] = t[a:a + count]  # numpy copies overlapping ranges safely
         n += count
     return sf[:n], si[:n], bnd[:n], bounded[:n], out[:n]
 

@@ -64,8 +64,9 @@ typedef struct {
 
 /* Shape hierarchy node columns (double, per bundle of rays; csrc/bvh.h): a bundle through
  * one apex (BVH_CONE) gets the double cone holding the lines that meet the balls below
- * (unit axis, the sine and cosine of its half-angle, its squared sine widened), parallel lines (BVH_FLAT) the box of the
- * balls' discs on two axes normal to them; then the least depth floor below, and that
+ * (unit axis, the sine and cosine of its half-angle, its squared sine widened), parallel
+ * lines (BVH_FLAT) the box of the balls' discs on two axes normal to them; then the least
+ * depth floor below, and that
  * floor rounded down to a float; a cone also gets its axis rounded to floats and the
  * widened squared sine of the float test (bvh.h cone_missed8), a box its bounds rounded
  * outwards to floats. */

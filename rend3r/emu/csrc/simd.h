@@ -61,6 +61,16 @@ INLINE double least4(f64x4 x)
     return x[0];
 }
 
+/* The box lo..hi (three axes) widened to the lanes of q (x, y, z) that m sets. */
+INLINE void box_join4(f64x4 lo[3], f64x4 hi[3], i64x4 m, const f64x4 q[3])
+{
+    const f64x4 inf = (f64x4){0} + INFINITY;
+    for (int k = 0; k < 3; k++) {
+        lo[k] = min4(lo[k], (f64x4)SEL_BITS(m, (i64x4)q[k], (i64x4)inf));
+        hi[k] = max4(hi[k], (f64x4)SEL_BITS(m, (i64x4)q[k], (i64x4)-inf));
+    }
+}
+
 /* |a x w|^2 for one vector a and eight vectors w, in float (products and sums rounded in
  * this order; bvh.h cone_missed8 and cull.h primary_culled8 bound its error). */
 INLINE f32x8 cross2_8(float a0, float a1, float a2, f32x8 w0, f32x8 w1, f32x8 w2)

@@ -52,7 +52,7 @@ setup(
     ext_modules=[
         Extension(
             "rend3r.emu._kernels",
-            sources=[str(CSRC / "kernels.c"), *sorted(str(p) for p in (CSRC / "instances").glob("*.c"))],
+            sources=[str(CSRC / "kernels.c"), str(CSRC / "setup.c"), *sorted(str(p) for p in (CSRC / "instances").glob("*.c"))],
             depends=[str(p) for p in sorted(CSRC.glob("*.[hi]*"))],
         )
     ],

@@ -11,72 +11,83 @@ zero depth floor, so every ray tests it.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
-from . import native, threads
+from . import native
 from .native import address
 
-#: Shapes a thread takes at least (the passes take about 30 ns a shape with AVX2: below this
-#: handing a range to another thread costs more than it saves).
-SHAPE_CHUNK = 1 << 14
+#: Shapes or items a range of a set-up pass takes at least (csrc/setup.c): the passes take
+#: about 30 ns a shape, and a team of threads hands a range over in about a microsecond.
+SHAPE_CHUNK = 1 << 10
+
+
+@dataclass
+class Pass:
+    """A bundle of rays' per-shape pass, run with its refit in one call (bvh.Tree.refit
+    ``shape_pass``): the kernels' block and the arrays it fills."""
+
+    block: native.Bundle
+    flags: np.ndarray  # bounded per shape, as uint8
+    radius: np.ndarray  # cull radius per shape
+    floor: np.ndarray | None = None  # primary rays: depth floor per shape
+    pc: np.ndarray | None = None  # primary rays: cull data per shape (PC_COLUMNS)
+    behind: np.ndarray | None = None  # a directional light's behind terms (n, 3)
+    keys: np.ndarray | None = None  # its stop keys (n, 3), or a point light's behind-test terms (n, SK_COLUMNS)
+    unit: np.ndarray | None = None  # a directional light's l / |l|
 
 
 def primary(table: np.ndarray, ok: np.ndarray, apex: np.ndarray, dmin: float, dmax: float, u: float, tiny: float,
-            overflow: float, jobs: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            overflow: float) -> Pass:
     """Per shape, for rays from ``apex`` with directions ``dmin``..``dmax`` long: the world
     radius beyond which no ray line can hit (inf: no bound), a lower bound of the computed
     ``sq_dist`` of any hit (0: none) and the cull data of the kernels' per-packet test
     (``csrc/kernels.h`` PC_COLUMNS); ``u``, ``tiny`` and ``overflow`` are the precision's
     unit roundoff, smallest normal and overflow threshold."""
     n = len(table)
-    table, flags = _inputs(table, ok)
-    apex = np.ascontiguousarray(apex, np.float64)
-    native.ptr(apex, np.float64, (3,))
-    radius, floor, pc = np.empty(n), np.empty(n), np.empty((n, native.PC_COLUMNS))
-    kernel = native.shape_pass("primary_shapes")
-    threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: kernel(
-        address(table[a:]), address(flags[a:]), b - a, address(apex), dmin, dmax, u, tiny, overflow,
-        address(radius[a:]), address(floor[a:]), address(pc[a:])))
-    return radius, floor, pc
+    p = _pass(table, ok, u, tiny, overflow, native.PASS_PRIMARY, floor=np.empty(n), pc=np.empty((n, native.PC_COLUMNS)))
+    p.block.apex[:] = [float(c) for c in apex]
+    p.block.dmin, p.block.dmax = dmin, dmax
+    p.block.floor, p.block.pc = address(p.floor), address(p.pc)
+    return p
 
 
 def shadow(table: np.ndarray, ok: np.ndarray, lo: np.ndarray, hi: np.ndarray, dmin: float, u: float, tiny: float,
-           overflow: float, *, chord: float = np.nan, unit: np.ndarray | None = None, length: float = 0.0,
-           jobs: int = 1) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+           overflow: float, *, chord: float = np.nan, unit: np.ndarray | None = None, length: float = 0.0) -> Pass:
     """Per shape, the cull radius of shadow rays from origins in the box ``lo``..``hi``
     with directions at least ``dmin`` long, widened by the origins' rounding and, for a
     point light, by ``chord`` (the largest turn of a rounded l off the line to the light);
     for a directional light along the unit vector ``unit`` (|l| = ``length``), also the
     behind terms and stop keys (n, 3 each) of the light pass's per-packet test
     (``csrc/kernels.h`` LightPass.behind, ``csrc/shape_bounds.inc`` shadow_shapes); for a
-    point light (``chord`` given) None and the terms of its per-node behind test (n,
-    SK_COLUMNS: ``csrc/cull.h`` point_behind4); else None and None."""
+    point light (``chord`` given) the terms of its per-node behind test (n, SK_COLUMNS:
+    ``csrc/cull.h`` point_behind4) as keys."""
     n = len(table)
-    table, flags = _inputs(table, ok)
     lo3, hi3 = [float(c) for c in lo], [float(c) for c in hi]  # 3-vectors: plain arithmetic
-    mid = np.array([(a + b) / 2 for a, b in zip(lo3, hi3)])
-    half = math.sqrt(sum((b - a) * (b - a) for a, b in zip(lo3, hi3))) / 2
-    magnitude = max(abs(c) for c in lo3 + hi3)  # of any origin's coordinates
+    p = _pass(table, ok, u, tiny, overflow, native.PASS_SHADOW)
+    b = p.block
+    b.mid[:] = [(a + c) / 2 for a, c in zip(lo3, hi3)]
+    b.half = math.sqrt(sum((c - a) * (c - a) for a, c in zip(lo3, hi3))) / 2
+    b.magnitude = max(abs(c) for c in lo3 + hi3)  # of any origin's coordinates
+    b.dmin, b.chord, b.l_len = dmin, chord, length
     if unit is not None:
-        unit = np.ascontiguousarray(unit, np.float64)
-        native.ptr(unit, np.float64, (3,))
-    radius = np.empty(n)
-    behind, keys = (None, None) if unit is None else (np.empty((n, 3)), np.empty((n, 3)))
-    point = np.empty((n, native.SK_COLUMNS)) if unit is None and chord == chord else None
-    kernel = native.shape_pass("shadow_shapes")
-    threads.split(jobs, threads.ranges(n, jobs, SHAPE_CHUNK), lambda a, b: kernel(
-        address(table[a:]), address(flags[a:]), b - a, address(mid), half, magnitude, dmin, chord, u, tiny,
-        overflow, None if unit is None else address(unit), length, address(radius[a:]),
-        None if behind is None else address(behind[a:]), None if keys is None else address(keys[a:]),
-        None if point is None else address(point[a:])))
-    return radius, behind, keys if point is None else point
+        p.unit = np.ascontiguousarray(unit, np.float64)
+        b.unit = native.ptr(p.unit, np.float64, (3,))
+        p.behind, p.keys = np.empty((n, 3)), np.empty((n, 3))
+        b.behind, b.keys = address(p.behind), address(p.keys)
+    elif chord == chord:
+        p.keys = np.empty((n, native.SK_COLUMNS))
+        b.point = address(p.keys)
+    return p
 
 
-def _inputs(table: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The per-shape inputs as the kernels read them (checked table, uint8 flags)."""
+def _pass(table: np.ndarray, ok: np.ndarray, u: float, tiny: float, overflow: float, kind: int, **arrays) -> Pass:
+    """A pass's block over the checked table and uint8 flags, with its radius array."""
     n = len(table)
     native.ptr(table, np.float64, (n, native.B_COLUMNS))
     flags = np.ascontiguousarray(ok, np.uint8)
     native.ptr(flags, np.uint8, (n,))
-    return table, flags
+    p = Pass(native.Bundle(), flags, np.empty(n), **arrays)
+    p.block.ok, p.block.pass_, p.block.u, p.block.tiny, p.block.overflow = address(flags), kind, u, tiny, overflow
+    return p

@@ -13,14 +13,13 @@ skipping a node never changes the nearest hit.
 
 from __future__ import annotations
 
-import functools
+from ctypes import byref
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import Rend3rError
-from . import native, threads
-from .bounds import SHAPE_CHUNK
+from . import bounds as shape_bounds, native, threads
 from .native import address
 
 
@@ -39,17 +38,18 @@ class Tree:
 
     def refit(self, bnd: np.ndarray, radius: np.ndarray, floor: np.ndarray | None = None, *,
               apex: np.ndarray | None = None, axes: np.ndarray | None = None,
-              keys: np.ndarray | None = None, jobs: int = 1) -> Bounds:
+              keys: np.ndarray | None = None, jobs: int = 1, shape_pass: native.Bundle | None = None) -> Bounds:
         """One bundle's node bounds around the balls (centre, ``radius``) of their shapes,
         and their least ``floor`` (None: -inf): the double cones around ``apex`` (lines
         through it) or the boxes on the two unit ``axes`` (2, 3) normal to parallel lines,
         with each shape's own box for parallel lines, and per node the largest of its
         shapes' stop ``keys`` (n, 3; parallel lines) or the joined terms of a point light's
         behind test (``keys`` n x SK_COLUMNS, per node PK_COLUMNS; lines through the apex,
-        ``csrc/kernels.c`` refit_cones). Each shape's own bound is
-        computed first, four shapes at a time (csrc/shape_bounds.inc), then joined node by
-        node; on ``jobs`` threads when there are many shapes (the nodes' subtrees side by
-        side, then the nodes above them)."""
+        ``csrc/kernels.c`` refit_cones). ``shape_pass`` (bounds.py) computes radius, floor
+        and keys first, in the same call. Each shape's own bound is computed first, then
+        joined node by node, on a team of ``jobs`` threads (``csrc/setup.c``
+        bundle_bounds: ranges of shapes and items, the nodes' subtrees side by side, then
+        the nodes above them)."""
         n = len(bnd)
         native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
         radius = np.ascontiguousarray(radius, np.float64)
@@ -60,43 +60,34 @@ class Tree:
             raise ValueError("refit: give the apex of the lines or the axes normal to them")
         if keys is not None:  # parallel lines' stop keys, or a point light's behind terms
             native.ptr(keys, np.float64, (n, 3 if axes is not None else native.SK_COLUMNS))
+        block = shape_pass if shape_pass is not None else native.Bundle()
+        block.bnd, block.n, block.radius = address(bnd), n, address(radius)
+        block.floor = None if floor is None else address(floor)
+        block.keys, block.point = (None, None) if keys is None else \
+            (address(keys), None) if axes is not None else (None, address(keys))
+        bounds, own = self.bounds_for(block, apex, axes, self.nodes, keys is not None, jobs)
+        with threads.team(jobs) as team:
+            native.library().bundle_bounds(byref(block), team)
+        del own  # a cone's own items: scratch, kept until the call returned
+        return bounds
+
+    def bounds_for(self, block: native.Bundle, apex: np.ndarray | None, axes: np.ndarray | None, nodes: int,
+                   keys: bool, jobs: int) -> tuple[Bounds, np.ndarray]:
+        """Points ``block`` at this tree (``nodes`` nodes at most) and at new arrays for its
+        bounds; returns the Bounds that holds them, and the shapes' own bounds (the block
+        points at them until its call returns)."""
         kind = native.BVH_CONE if apex is not None else native.BVH_FLAT
         frame = np.zeros(6)
         frame[: 3 if apex is not None else 6] = np.ravel(apex if apex is not None else axes)
         # each shape's own cone (a scratch array) or box (kept: shadow packets test it), then the nodes'
         own = np.empty((len(self.items), native.CI_COLUMNS if apex is not None else native.BX_COLUMNS))
-        items = native.shape_pass("cone_items" if apex is not None else "flat_items")
-        parts = threads.ranges(len(self.items), jobs, SHAPE_CHUNK)
-        threads.split(jobs, parts, lambda a, b: items(address(self.items[a:]), b - a, address(bnd), address(radius),
-                                                      address(frame), address(own[a:])))
-        bounds = Bounds(self, np.empty((self.nodes, native.BV_COLUMNS)), frame, own if axes is not None else None,
-                        None if keys is None else np.empty((self.nodes, 3 if axes is not None else native.PK_COLUMNS)))
-        refit = functools.partial(native.library().bvh_refit, bounds.struct(),
-                                  None if floor is None else address(floor), kind, address(bounds.box), address(own),
-                                  None if keys is None else address(keys),
-                                  None if keys is None else address(bounds.keys))
-        below, above = self.subtrees(len(parts))
-        threads.split(jobs, below, refit)
-        for at in above:
-            refit(at, at + 1)
-        return bounds
-
-    def subtrees(self, count: int) -> tuple[list[tuple[int, int]], list[int]]:
-        """The node ranges of at least ``count`` disjoint subtrees (fewer when the tree
-        has fewer leaves), largest first, and the nodes above them, children before their
-        parents. Nodes are depth first: node ``at``'s left child is ``at + 1``, its right
-        child ``node[at, 0]`` (when ``node[at, 1]``, its shape count, is 0)."""
-        below, above = [(0, self.nodes)] if self.nodes else [], []
-        while len(below) < count:
-            inner = [r for r in below if self.node[r[0], 1] == 0 and r[1] - r[0] > 1]
-            if not inner:
-                break
-            lo, hi = max(inner, key=lambda r: r[1] - r[0])
-            right = int(self.node[lo, 0])
-            below.remove((lo, hi))
-            below += [(lo + 1, right), (right, hi)]
-            above.append(lo)
-        return sorted(below, key=lambda r: r[0] - r[1]), above[::-1]
+        bounds = Bounds(self, np.empty((nodes, native.BV_COLUMNS)), frame, own if axes is not None else None,
+                        None if not keys else np.empty((nodes, 3 if axes is not None else native.PK_COLUMNS)))
+        block.kind, block.tree, block.items = kind, bounds.struct(), len(self.items)
+        block.box, block.own = address(bounds.box), address(own)
+        block.node_keys = None if bounds.keys is None else address(bounds.keys)
+        block.jobs, block.avx2, block.chunk = jobs, native.isa() == "avx2", shape_bounds.SHAPE_CHUNK
+        return bounds, own
 
 
 @dataclass(frozen=True)

@@ -104,6 +104,32 @@ class LightPass(Structure):
                 ("point_keys", c_void_p)]
 
 
+class Setup(Structure):
+    """A frame's set-up (csrc/kernels.h Setup, csrc/setup.c frame_setup)."""
+
+    _fields_ = [("tables", c_void_p), ("values", c_void_p), ("index", c_void_p), ("rows", c_int64), ("props", c_void_p),
+                ("kinds", c_void_p), ("cam", c_void_p), ("tiny", c_double), ("format", POINTER(Format)),
+                ("sf", c_void_p), ("sf_row", c_int64), ("si", c_void_p), ("bnd", c_void_p), ("bounded", c_void_p),
+                ("index_out", c_void_p), ("items", c_void_p), ("always", c_void_p), ("node", c_void_p),
+                ("counts", c_int64 * 2), ("nodes", c_int64), ("shapes", c_int64), ("jobs", c_int32),
+                ("chunk", c_int64)]
+
+
+PASS_NONE, PASS_PRIMARY, PASS_SHADOW = 0, 1, 2  # a Bundle's shape pass (csrc/kernels.h)
+
+
+class Bundle(Structure):
+    """One bundle of rays' bounds (csrc/kernels.h Bundle, csrc/setup.c bundle_bounds)."""
+
+    _fields_ = [("bnd", c_void_p), ("ok", c_void_p), ("n", c_int64), ("pass_", c_int32), ("kind", c_int32),
+                ("apex", c_double * 3), ("dmin", c_double), ("dmax", c_double), ("mid", c_double * 3),
+                ("half", c_double), ("magnitude", c_double), ("chord", c_double), ("l_len", c_double),
+                ("unit", c_void_p), ("u", c_double), ("tiny", c_double), ("overflow", c_double),
+                ("radius", c_void_p), ("floor", c_void_p), ("pc", c_void_p), ("behind", c_void_p),
+                ("keys", c_void_p), ("point", c_void_p), ("tree", Bvh), ("items", c_int64), ("box", c_void_p),
+                ("own", c_void_p), ("node_keys", c_void_p), ("jobs", c_int32), ("avx2", c_int32), ("chunk", c_int64)]
+
+
 #: Pixels a band may hold and the widest frame, for Band.row_magic (csrc/kernels.h band_row).
 BAND_LIMIT, WIDTH_LIMIT = 1 << 20, 8192
 
@@ -132,6 +158,11 @@ def ptr(a: np.ndarray, dtype: type | np.dtype, shape: tuple[int | None, ...]) ->
     return address(a)
 
 
+def function_address(fn: ctypes._CFuncPtr) -> int:
+    """The address of a compiled function (for the blocks that call one, e.g. Setup.tables)."""
+    return cast(fn, c_void_p).value
+
+
 #: Kernel suffix per (precision, flush subnormals); narrow formats' kernels are NARROW's (float
 #: lanes, csrc/fnarrow.h), every other format's FORMAT's (double lanes, csrc/fformat.h).
 SUFFIXES = {("fp16", True): "h16", ("fp16", False): "h16i", ("fp32", True): "f32", ("fp32", False): "f32",
@@ -157,6 +188,11 @@ _PLAIN = {
     "pair_marks": (c_int64, [POINTER(Pairs), c_void_p]),
     "pair_apply": (None, [POINTER(Pairs), c_void_p, c_void_p]),
     "mark_rows": (c_int64, [c_void_p, c_int64, c_void_p, c_void_p]),
+    "team_bytes": (c_int64, []),
+    "team_member": (None, [c_void_p]),
+    "team_end": (None, [c_void_p]),
+    "frame_setup": (c_int64, [POINTER(Setup), POINTER(Bundle), c_void_p]),
+    "bundle_bounds": (None, [POINTER(Bundle), c_void_p]),
 }
 _PER_ISA = {  # name: (restype, argtypes); each exists once per instruction set (double lanes)
     "primary_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,

@@ -32,6 +32,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..errors import Rend3rError
 from ..isa import Table, lookup
 from ..isa.tables import PROP_LIMIT, SHAPE_TYPE_CODES
 from . import bounds, bvh, native, threads
@@ -76,11 +77,8 @@ class _Frame:
     light_rows: np.ndarray
     jobs: int
     shapes: native.Shapes
-    built: Callable[[], bvh.Tree]  # the hierarchy, built beside the rest of the set-up
-
-    @property
-    def tree(self) -> bvh.Tree:
-        return self.built()
+    tree: bvh.Tree
+    primary: _Primary | None  # a grid camera's primary bounds (None: each band measures its directions)
 
     def kernel(self, name: str):
         """The compiled kernel ``name`` for this frame's precision."""
@@ -102,8 +100,7 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
         if fr.jobs > 1 and len(fr.sf) * PIXELS_PER_SHAPE <= n_pix:  # a band per thread at least
             rows = min(rows, -(-h // fr.jobs))
         bands = [(row0, min(h, row0 + rows)) for row0 in range(0, h, rows)]
-        extent = _extent(fr)  # a grid camera's bands share one set of primary bounds
-        primary = _primary_tree(fr, *extent) if extent is not None else None
+        primary = fr.primary  # a grid camera's bands share one set of primary bounds
         # several bands: side by side on the threads, each single-threaded; one: its steps split
         one = replace(fr, jobs=1) if len(bands) > 1 else fr
         done = (lambda k: progress(bands[k][1] / h)) if progress is not None else None
@@ -117,7 +114,8 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
 
 
 def set_up(scene: Scene, options: EmuOptions) -> _Frame:
-    """What every band of the frame shares: camera, shape and light tables."""
+    """What every band of the frame shares: camera, shape and light tables, the shape
+    hierarchy and, for a grid camera, the primary rays' bounds."""
     ar = options.arith
     dtype = native.dtype(ar)
     rays = camera_rays(scene, options, ar)
@@ -126,17 +124,17 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     cam[native.CAM_TMIN], cam[native.CAM_TMAX], cam[native.CAM_Z] = rays.tmin, rays.tmax, rays.z
     if rays.rotation is not None:  # the kernel turns (x[col], y[row], z) per pixel
         cam[native.CAM_ROT:native.CAM_ROT + 4] = [np.asarray(c, dtype) for c in rays.rotation]
+    xs, ys = np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype)
     fmt = None if ar.native else native.Format.of(ar)
     jobs = options.jobs or threads.available_cores()
-    sf, si, bnd, bounded, index = _shape_tables(scene, ar, fmt, cam, jobs)
-    built = threads.beside(jobs, bvh.build, bnd, bounded)  # on a helper while the primary bounds are computed
+    extent = _extent(cam, xs, ys, rays.rotation is not None)
+    sf, si, bnd, bounded, index, tree, primary = _shapes(scene, ar, fmt, cam, extent, jobs)
     lights = lights_from_scene(scene, ar, options.light_model)
     n = len(sf)
     view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
                          native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny, fmt)
-    return _Frame(ar, dtype, cam, np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype),
-                  rays.rotation is not None, sf, si, index, bnd, bounded, lights,
-                  _light_rows(lights, dtype), jobs, view, built)
+    return _Frame(ar, dtype, cam, xs, ys, rays.rotation is not None, sf, si, index, bnd, bounded, lights,
+                  _light_rows(lights, dtype), jobs, view, tree, primary)
 
 
 #: The shape table's columns the kernels read, and the type codes of the normal forms.
@@ -146,37 +144,47 @@ _KINDS = np.array([SHAPE_TYPE_CODES["sphere"], SHAPE_TYPE_CODES["cylinder"], SHA
                    lookup(Table.SHAPE, "type").value_mask], np.int32)
 
 
-def _shape_tables(scene: Scene, ar: Arith, fmt, cam: np.ndarray, jobs: int) -> tuple[np.ndarray, ...]:
+def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, float] | None,
+            jobs: int) -> tuple:
     """The shapes that are on, as the kernels' tables (csrc/datapath.inc shape_tables, with
     the camera origin ``cam`` in each shape's normal space): (floats, ints, bounds,
-    bounded, program index), in index order; many rows are split over ``jobs`` threads,
-    each range's shapes then moved up behind the previous range's. Spheres with moderate
-    maps are bounded (culled, csrc/bounds.h) in every format: a test that overflows is a
-    miss, and a format too coarse for the bounds (docs/emulator.md section 7) gets infinite
-    cull radii from them."""
+    bounded, program index) in index order, then the hierarchy over them and, given the
+    primary directions' ``extent``, the primary rays' bounds; in one call on a team of
+    ``jobs`` threads (csrc/setup.c frame_setup). Spheres with moderate maps are bounded
+    (culled, csrc/bounds.h) in every format: a test that overflows is a miss, and a format
+    too coarse for the bounds (docs/emulator.md section 7) gets infinite cull radii from
+    them."""
     table = scene.objects
     values = np.ascontiguousarray(table.values, np.uint16)
     index = np.ascontiguousarray(table.index, np.int64)
     rows = len(index)
-    native.ptr(values, np.uint16, (rows, PROP_LIMIT))
-    sf = np.empty((rows, native.SF_COLUMNS), native.dtype(ar))  # shape_tables fills it
-    si = np.empty((rows, native.SI_COLUMNS), np.int64)
-    bnd = np.empty((rows, native.B_COLUMNS))
-    bounded = np.empty(rows, np.uint8)
-    out = np.empty(rows, np.int32)
-    tables = (sf, si, bnd, bounded, out)
-    kernel, cam_ptr = native.kernel("shape_tables", ar), native.ptr(cam, sf.dtype, (native.CAM_COLUMNS,))
-    parts = threads.ranges(rows, jobs, bounds.SHAPE_CHUNK)
-    counts = threads.each(jobs, [lambda a=a, b=b: kernel(
-        address(values[a:]), address(index[a:]), b - a, address(_SHAPE_PROPS), address(_KINDS), cam_ptr, ar.tiny,
-        *(address(t[a:]) for t in tables), fmt) for a, b in parts])
-    n = 0
-    for (a, _), count in zip(parts, counts):
-        if a != n:  # rows before a were off
-            for t in tables:
-                t[n:n + count] = t[a:a + count]  # numpy copies overlapping ranges safely
-        n += count
-    return sf[:n], si[:n], bnd[:n], bounded[:n], out[:n]
+    dtype = native.dtype(ar)
+    s = native.Setup(native.function_address(native.kernel("shape_tables", ar)),
+                     native.ptr(values, np.uint16, (rows, PROP_LIMIT)), address(index), rows, address(_SHAPE_PROPS),
+                     address(_KINDS), native.ptr(cam, dtype, (native.CAM_COLUMNS,)), ar.tiny, fmt)
+    sf = np.empty((rows, native.SF_COLUMNS), dtype)  # frame_setup fills them
+    si, bnd = np.empty((rows, native.SI_COLUMNS), np.int64), np.empty((rows, native.B_COLUMNS))
+    bounded, out = np.empty(rows, np.uint8), np.empty(rows, np.int32)
+    s.sf, s.sf_row, s.si, s.bnd, s.bounded, s.index_out = (address(sf), sf.strides[0], address(si), address(bnd),
+                                                           address(bounded), address(out))
+    room = bvh.Tree(np.empty((max(1, 2 * rows), 2), np.int32), np.empty(rows, np.int32), np.empty(rows, np.int32))
+    s.node, s.items, s.always = address(room.node), address(room.items), address(room.always)
+    s.jobs, s.chunk = jobs, bounds.SHAPE_CHUNK
+    first = scratch = None
+    if extent is not None:  # the primary bounds in the same call, around the camera origin
+        apex = cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)  # at infinity: nothing is bounded
+        first = bounds.primary(bnd, bounded, apex, *extent, ar.unit_roundoff, ar.tiny, ar.overflow)
+        first.block.bnd, first.block.radius = address(bnd), address(first.radius)
+        fitted, scratch = room.bounds_for(first.block, apex, None, room.nodes, False, jobs)
+    with threads.team(jobs) as team:
+        n = native.library().frame_setup(byref(s), None if first is None else byref(first.block), team)
+    del scratch  # the shapes' own cones: the call's, until it returned
+    if n < 0:
+        raise Rend3rError(f"not enough memory to build the shape hierarchy of {rows:,} shapes")
+    tree = bvh.Tree(room.node[:s.nodes], room.items[:s.counts[0]], room.always[:s.counts[1]])
+    primary = None if first is None else \
+        (bvh.Bounds(tree, fitted.box[:s.nodes], fitted.frame), first.floor[:n], first.pc[:n])
+    return sf[:n], si[:n], bnd[:n], bounded[:n], out[:n], tree, primary
 
 
 @dataclass(frozen=True)
@@ -322,14 +330,14 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
 _Primary = tuple[bvh.Bounds, np.ndarray, np.ndarray]
 
 
-def _extent(fr: _Frame) -> tuple[float, float] | None:
+def _extent(cam: np.ndarray, xs: np.ndarray, ys: np.ndarray, rotated: bool) -> tuple[float, float] | None:
     """The shortest and longest primary direction of the frame for a camera whose
     directions are (x[col], y[row], z), all finite and z not zero; None for other cameras
     (each band measures its directions as the kernels compute them)."""
-    z = float(fr.cam[native.CAM_Z])
-    if fr.rotated or not (z != 0 and math.isfinite(z)):
+    z = float(cam[native.CAM_Z])
+    if rotated or not (z != 0 and math.isfinite(z)):
         return None
-    xx, yy = np.square(fr.xs, dtype=np.float64), np.square(fr.ys, dtype=np.float64)
+    xx, yy = np.square(xs, dtype=np.float64), np.square(ys, dtype=np.float64)
     x0, x1, y0, y1 = float(xx.min()), float(xx.max()), float(yy.min()), float(yy.max())
     if not (math.isfinite(x1) and math.isfinite(y1)):  # an infinite or NaN direction (NaN propagates)
         return None
@@ -340,9 +348,8 @@ def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> _Primary:
     """The hierarchy's bounds for the primary rays (directions dmin..dmax long), and per
     shape its depth floor and cull data."""
     apex = fr.cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)  # at infinity: nothing is bounded
-    radius, floor, pc = bounds.primary(fr.bnd, fr.bounded, apex, dmin, dmax, fr.ar.unit_roundoff, fr.ar.tiny,
-                                       fr.ar.overflow, fr.jobs)
-    return fr.tree.refit(fr.bnd, radius, floor, apex=apex, jobs=fr.jobs), floor, pc
+    p = bounds.primary(fr.bnd, fr.bounded, apex, dmin, dmax, fr.ar.unit_roundoff, fr.ar.tiny, fr.ar.overflow)
+    return fr.tree.refit(fr.bnd, p.radius, p.floor, apex=apex, jobs=fr.jobs, shape_pass=p.block), p.floor, p.pc
 
 
 def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.ndarray, n_pix: int,
@@ -408,16 +415,15 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
         if not origins[8]:
             return _unbounded(fr, lp)
         bounded = fr.bounded & bool(np.isfinite(apex).all())
-        radius, _, terms = bounds.shadow(fr.bnd, bounded, lo, hi, float(origins[9]), *limits,
-                                         chord=float(origins[7]), jobs=fr.jobs)
-        return _ShadowBounds(radius, fr.tree.refit(fr.bnd, radius, apex=apex, keys=terms, jobs=fr.jobs))
+        p = bounds.shadow(fr.bnd, bounded, lo, hi, float(origins[9]), *limits, chord=float(origins[7]))
+        return _ShadowBounds(p.radius, fr.tree.refit(fr.bnd, p.radius, apex=apex, keys=p.keys, jobs=fr.jobs,
+                                                     shape_pass=p.block))
     length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
         return _unbounded(fr, lp)
-    radius, behind, keys = bounds.shadow(fr.bnd, fr.bounded, lo, hi, length, *limits, unit=unit, length=length,
-                                         jobs=fr.jobs)
-    flat = fr.tree.refit(fr.bnd, radius, axes=_normal_plane(unit), keys=keys, jobs=fr.jobs)
-    return _ShadowBounds(radius, flat, behind, length, unit)
+    p = bounds.shadow(fr.bnd, fr.bounded, lo, hi, length, *limits, unit=unit, length=length)
+    flat = fr.tree.refit(fr.bnd, p.radius, axes=_normal_plane(unit), keys=p.keys, jobs=fr.jobs, shape_pass=p.block)
+    return _ShadowBounds(p.radius, flat, p.behind, length, unit)
 
 
 def _unbounded(fr: _Frame, lp: native.LightPass) -> _ShadowBounds:

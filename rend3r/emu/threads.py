@@ -16,8 +16,13 @@ from __future__ import annotations
 import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from functools import lru_cache
-from typing import Callable, TypeVar
+from typing import Callable, Iterator, TypeVar
+
+import numpy as np
+
+from . import native
 
 T = TypeVar("T")
 
@@ -102,16 +107,19 @@ def each(jobs: int, calls: list[Callable[[], T]], done: Callable[[int], None] | 
     return results
 
 
-def beside(jobs: int, fn: Callable[..., T], *args: object) -> Callable[[], T]:
-    """``fn(*args)`` on a helper while this thread goes on (here and now with one job);
-    returns a function that waits for its result. Calls that :func:`each` hands to the
-    busy helper wait behind it, so this thread takes them meanwhile."""
-    if jobs <= 1:
-        value = fn(*args)
-        return lambda: value
-    return _helpers(jobs - 1).submit(fn, *args).result
+@contextmanager
+def team(jobs: int) -> Iterator[int]:
+    """A team of threads for a compiled call (csrc/team.h): ``jobs - 1`` helpers join it
+    while the block runs, and the address yielded is passed to the calls that lead it. The
+    helpers may join late (the calls never wait for them) and leave when the block ends."""
+    lib = native.library()
+    state = np.zeros(lib.team_bytes(), np.uint8)  # kept alive by the calls below, even for a late helper
+    at = native.address(state)
+    members = [_helpers(jobs - 1).submit(lambda: lib.team_member(native.address(state))) for _ in range(jobs - 1)]
+    try:
+        yield at
+    finally:
+        lib.team_end(at)
+        for member in members:
+            member.cancel()  # one not started has nothing to do
 
-
-def split(jobs: int, parts: list[tuple[int, int]], fn: Callable[[int, int], object]) -> None:
-    """``fn(a, b)`` over the ranges ``parts`` on ``jobs`` threads."""
-    each(jobs, [lambda a=a, b=b: fn(a, b) for a, b in parts])

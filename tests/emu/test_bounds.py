@@ -60,9 +60,9 @@ def test_every_computed_hit_is_within_the_cull_radius_and_beyond_the_depth_floor
     d = _rays(ar, center, o64, 1.0 / (inv * min(1.0, stretch)), np.random.default_rng(seed))
     d64 = np.stack([np.asarray(c, np.float64) for c in d], axis=1)
     length = np.linalg.norm(d64, axis=1)
-    radius, floor, _ = bounds.primary(table, ok, o64, length.min(), length.max(), ar.unit_roundoff, ar.tiny,
-                                      ar.overflow)
-    radius, floor = radius[0], floor[0]
+    p = bounds.primary(table, ok, o64, length.min(), length.max(), ar.unit_roundoff, ar.tiny, ar.overflow)
+    fr.tree.refit(table, p.radius, p.floor, apex=o64, shape_pass=p.block)
+    radius, floor = p.radius[0], p.floor[0]
     s = shapes.take(0)
     S, D = to_object(ar, s, origin, d)
     sol = solve(ar, s, S, D, origin_term(ar, s, S), ar.const(0.0), ar.const(np.inf))

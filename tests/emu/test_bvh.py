@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from rend3r.emu import bvh, native
+from rend3r.emu import bounds, bvh, native
 
 STACK = 64  # csrc/bvh.h BVH_STACK
 
@@ -165,16 +165,7 @@ def test_refit_on_threads_gives_the_same_bits(n, seed, jobs):
     bnd, radius, floor = shapes(n, seed)
     keys = np.random.default_rng(seed).normal(size=(n, 3))
     tree = bvh.build(bnd, np.ones(n, bool))
-    below, above = tree.subtrees(4 * jobs)
-    spans = sorted([(lo, hi) for lo, hi in below] + [(at, at + 1) for at in above])
-    assert [lo for lo, _ in spans] == list(np.cumsum([0] + [hi - lo for lo, hi in spans[:-1]]))
-    assert sum(hi - lo for lo, hi in spans) == tree.nodes  # disjoint, covering every node
-    for at in above:  # a node's children are refitted before it
-        first = int(tree.node[at, 0])
-        later = above[above.index(at) + 1:]
-        assert at + 1 not in later and first not in later
-    import rend3r.emu.bvh as module
-    chunk, module.SHAPE_CHUNK = module.SHAPE_CHUNK, 8
+    chunk, bounds.SHAPE_CHUNK = bounds.SHAPE_CHUNK, 8
     try:
         for kw, columns in (({"apex": np.array([0.5, -1.0, 2.0])}, slice(None)),
                             ({"axes": np.array([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0]]), "keys": keys},
@@ -185,7 +176,37 @@ def test_refit_on_threads_gives_the_same_bits(n, seed, jobs):
             if one.keys is not None:
                 assert one.keys.tobytes() == many.keys.tobytes()
     finally:
-        module.SHAPE_CHUNK = chunk
+        bounds.SHAPE_CHUNK = chunk
+
+
+@settings(max_examples=20, derandomize=True)
+@given(st.integers(1, 400), st.integers(0, 2**32 - 1), st.integers(2, 5))
+def test_shape_passes_on_threads_give_the_same_bits(n, seed, jobs):
+    """A bundle's shape pass, own bounds and refit in one call on a team of threads
+    (csrc/setup.c bundle_bounds): the primary rays' and both lights' shadow rays' per-shape
+    arrays and node bounds exactly as one thread computes them."""
+    bnd, _, _ = shapes(n, seed)
+    ok = np.random.default_rng(seed).random(n) < 0.9
+    tree = bvh.build(bnd, ok)
+    apex, axes, unit = np.array([0.5, -1.0, 2.0]), np.array([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0]]), np.array([0, 0, 1.0])
+    lo, hi, limits = bnd[:, :3].min(axis=0), bnd[:, :3].max(axis=0), (2.0**-24, 2.0**-126, 3.4e38)
+    passes = (lambda: bounds.primary(bnd, ok, apex, 0.5, 2.0, *limits), {"apex": apex},
+              lambda: bounds.shadow(bnd, ok, lo, hi, 2.0, *limits, unit=unit, length=2.0), {"axes": axes},
+              lambda: bounds.shadow(bnd, ok, lo, hi, 0.5, *limits, chord=1e-3), {"apex": apex})
+    chunk, bounds.SHAPE_CHUNK = bounds.SHAPE_CHUNK, 8
+    try:
+        for make, kw in zip(passes[::2], passes[1::2]):
+            runs = []
+            for j in (1, jobs):
+                p = make()
+                b = tree.refit(bnd, p.radius, p.floor, keys=p.keys, jobs=j, shape_pass=p.block, **kw)
+                box = b.box if "apex" in kw else np.delete(b.box, [4, 5], axis=1)  # a box's columns
+                runs.append([p.radius, p.floor, p.pc, p.behind, p.keys, box, b.keys, b.item_box])
+            for one, many in zip(*runs):
+                assert (one is None) == (many is None)
+                assert one is None or one.tobytes() == many.tobytes()
+    finally:
+        bounds.SHAPE_CHUNK = chunk
 
 
 @settings(max_examples=30, derandomize=True)

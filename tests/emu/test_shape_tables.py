@@ -59,8 +59,9 @@ def test_tables_hold_the_values_the_reference_reads(precision, rows, seed):
 @settings(max_examples=30, derandomize=True)
 @given(st.integers(0, 300), st.integers(0, 2**32 - 1), st.integers(2, 4))
 def test_tables_split_over_threads_are_the_same(rows, seed, jobs):
-    """Ranges of rows on several threads, then moved up past the rows that are off: the
-    same tables, bit for bit (small ranges force splits)."""
+    """Ranges of rows on a team of threads, then moved up past the rows that are off, the
+    tree and the primary bounds (csrc/setup.c frame_setup): the same tables, tree and
+    bounds, bit for bit (small ranges force splits)."""
     from rend3r.emu import bounds
 
     rng = np.random.default_rng(seed)
@@ -76,3 +77,34 @@ def test_tables_split_over_threads_are_the_same(rows, seed, jobs):
         bounds.SHAPE_CHUNK = chunk
     for name in ("sf", "si", "bnd", "bounded", "index"):
         assert getattr(one, name).tobytes() == getattr(many, name).tobytes(), name
+    for name in ("node", "items", "always"):  # the tree built in the same call, and the primary bounds
+        assert getattr(one.tree, name).tobytes() == getattr(many.tree, name).tobytes(), name
+    assert (one.primary is None) == (many.primary is None)
+    if one.primary is not None:
+        (box, *arrays), (box2, *arrays2) = one.primary, many.primary
+        assert box.box.tobytes() == box2.box.tobytes()
+        assert all(a.tobytes() == b.tobytes() for a, b in zip(arrays, arrays2))
+
+
+def test_teams_led_side_by_side_on_busy_helpers():
+    """Two frames set up at once on the two threads of threads.each, each leading a team of
+    two whose helper is the other frame's thread (busy): a team never waits for a member,
+    so each set-up runs on its own thread and gets the same bits as with one job."""
+    from rend3r.emu import bounds, threads
+
+    rng = np.random.default_rng(7)
+    scene = Scene()
+    rows = 200
+    values = rng.integers(0, 1 << 16, size=(rows, PROP_LIMIT), dtype=np.uint16)
+    values[:, prop_index(Table.SHAPE, "type")] = 1
+    scene.objects.index = np.arange(rows, dtype=np.int64)
+    scene.objects.values = values
+    chunk, bounds.SHAPE_CHUNK = bounds.SHAPE_CHUNK, 8
+    try:
+        one = set_up(scene, EmuOptions(jobs=1))
+        frames = threads.each(2, [lambda: set_up(scene, EmuOptions(jobs=2))] * 2)
+    finally:
+        bounds.SHAPE_CHUNK = chunk
+    for fr in frames:
+        assert fr.sf.tobytes() == one.sf.tobytes() and fr.tree.node.tobytes() == one.tree.node.tobytes()
+        assert fr.primary[0].box.tobytes() == one.primary[0].box.tobytes()

@@ -150,6 +150,63 @@ typedef struct {            /* one light over one band */
                                  test's terms (cull.h point_behind4) */
 } LightPass;
 
+/* Property words per object table row (isa PROP_LIMIT). */
+enum { PROP_WORDS = 32 };
+
+/* A precision's shape_tables (datapath.inc). */
+typedef int64_t (*ShapeTablesFn)(const uint16_t *values, const int64_t *index, int64_t rows, const int32_t *props,
+                                 const int32_t *kinds, const void *cam, double tiny, void *sf, int64_t *si,
+                                 double *bnd, uint8_t *bounded, int32_t *index_out, const Format *format);
+
+typedef struct {            /* a frame's set-up (setup.c frame_setup) */
+    ShapeTablesFn tables;
+    const uint16_t *values; /* the object table: rows x PROP_WORDS, and each row's program index */
+    const int64_t *index;
+    int64_t rows;
+    const int32_t *props, *kinds; /* shape_tables' columns and type codes */
+    const void *cam;        /* CAM_COLUMNS, working */
+    double tiny;
+    const Format *format;
+    char *sf;               /* out, room for rows: the shape tables (sf_row bytes a float row) */
+    int64_t sf_row;
+    int64_t *si;
+    double *bnd;
+    uint8_t *bounded;
+    int32_t *index_out;
+    int32_t *items, *always, *node; /* out, room for rows, rows and max(1, 2 rows) nodes: the tree */
+    int64_t counts[2];      /* out: the tree's items and the shapes outside it */
+    int64_t nodes;          /* out: its nodes */
+    int64_t shapes;         /* out: the shapes on */
+    int32_t jobs;           /* threads the passes split over */
+    int64_t chunk;          /* rows a range takes at least */
+} Setup;
+
+/* A bundle's shape pass: none (radii given), the primary rays' (shape_bounds.inc
+ * primary_shapes) or a light's shadow rays' (shadow_shapes). */
+enum { PASS_NONE = 0, PASS_PRIMARY = 1, PASS_SHADOW = 2 };
+
+typedef struct {            /* one bundle of rays' bounds (setup.c bundle_bounds) */
+    const double *bnd;      /* n x B_COLUMNS */
+    const uint8_t *ok;      /* per shape: bounded */
+    int64_t n;
+    int32_t pass;
+    int32_t kind;           /* BVH_CONE (lines through tree.frame[0..3)) or BVH_FLAT (normal to two axes) */
+    double apex[3], dmin, dmax; /* primary_shapes' rays (dmin also shadow_shapes') */
+    double mid[3], half, magnitude, chord, l_len; /* shadow_shapes' */
+    const double *unit;
+    double u, tiny, overflow;
+    double *radius;         /* n: out of the shape pass, else given */
+    double *floor, *pc;     /* primary: out, n and n x PC_COLUMNS (floor NULL for shadow rays) */
+    double *behind, *keys;  /* directional shadow rays: out, n x 3 each (else NULL) */
+    double *point;          /* point-light shadow rays: out, n x SK_COLUMNS (else NULL) */
+    Bvh tree;               /* node, items, frame, nodes of the tree */
+    int64_t items;          /* the tree's items */
+    double *box, *own;      /* out: nodes x BV_COLUMNS, items x CI_COLUMNS (cone) or BX_COLUMNS (flat) */
+    double *node_keys;      /* out where keys or point is given: nodes x 3 or PK_COLUMNS */
+    int32_t jobs, avx2;     /* threads the passes split over; the AVX2 shape passes */
+    int64_t chunk;          /* shapes or items a range takes at least */
+} Bundle;
+
 /* The row within its band of pixel p: (p * row_magic) >> 40 equals p / width exactly for
  * p < 2**20 and width <= 8192 (the error p * (row_magic - 2**40/width) / 2**40 < 2**-20
  * stays below the 1/width a fraction p/width keeps from the next integer). */

@@ -1,0 +1,335 @@
+/* A frame's set-up in one compiled call, its passes split over a team of threads
+ * (team.h): the shape tables, the shape hierarchy, and each bundle of rays' bounds
+ * (rend3r/emu/raytracer.py set_up, bvh.py, bounds.py). Between the passes no Python
+ * runs, and passes of a few tens of microseconds split over the cores, which a hand-off
+ * through Python (a helper's wake-up, then the GIL) cost as much as it saved.
+ *
+ * Every pass computes each shape, item or node the same way whatever the split, so the
+ * bits never depend on the thread count.
+ */
+#include <stdint.h>
+#include <string.h>
+
+#include "kernels.h"
+#include "team.h"
+
+/* ---- the team (team.h) ---- */
+
+int64_t team_bytes(void)
+{
+    return (int64_t)sizeof(Team);
+}
+
+#if TEAM_SOLO
+void team_member(Team *t)
+{
+    (void)t;
+}
+
+void team_end(Team *t)
+{
+    t->released = TEAM_ENDED;
+}
+
+static void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
+{
+    (void)t;
+    for (int64_t k = 0; k < tasks; k++)
+        fn(ctx, k);
+}
+#else
+/* Waits a little (the other threads run on other cores), then yields the core: a team of
+ * more threads than cores must not spin against its own leader. */
+static inline void team_wait(int64_t *spins)
+{
+    if (++*spins < 2048) {
+#if defined(__x86_64__) || defined(__i386__)
+        __builtin_ia32_pause();
+#endif
+    } else {
+        sched_yield();
+    }
+}
+
+/* Takes the next tasks of phase p until none is left. */
+static void team_take(Team *t, int64_t p)
+{
+    TeamPhase *ph = &t->at[p];
+    for (;;) {
+        int64_t k = atomic_fetch_add_explicit(&ph->next, 1, memory_order_relaxed);
+        if (k >= ph->tasks)
+            return;
+        ph->fn(ph->ctx, k);
+        atomic_fetch_add_explicit(&ph->finished, 1, memory_order_release);
+    }
+}
+
+/* A member: takes tasks of every phase released until the team ends. */
+void team_member(Team *t)
+{
+    int64_t seen = 0, spins = 0;
+    for (;;) {
+        int64_t released = atomic_load_explicit(&t->released, memory_order_acquire);
+        if (released == TEAM_ENDED)
+            return;
+        if (released > seen) {
+            for (; seen < released; seen++)
+                team_take(t, seen);
+            spins = 0;
+        } else {
+            team_wait(&spins);
+        }
+    }
+}
+
+void team_end(Team *t)
+{
+    atomic_store_explicit(&t->released, TEAM_ENDED, memory_order_release);
+}
+
+/* Runs tasks 0..tasks of fn on the team; returns once every one has finished. */
+static void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
+{
+    int64_t p = atomic_load_explicit(&t->released, memory_order_relaxed);
+    if (p >= TEAM_PHASES || tasks <= 1) {  /* out of phases (or one task): this thread alone */
+        for (int64_t k = 0; k < tasks; k++)
+            fn(ctx, k);
+        return;
+    }
+    TeamPhase *ph = &t->at[p];
+    ph->fn = fn;
+    ph->ctx = ctx;
+    ph->tasks = tasks;
+    atomic_store_explicit(&ph->next, 0, memory_order_relaxed);
+    atomic_store_explicit(&ph->finished, 0, memory_order_relaxed);
+    atomic_store_explicit(&t->released, p + 1, memory_order_release);
+    team_take(t, p);
+    int64_t spins = 0;
+    while (atomic_load_explicit(&ph->finished, memory_order_acquire) < tasks)
+        team_wait(&spins);
+}
+#endif
+
+/* ---- ranges of work ---- */
+
+/* The most ranges a pass splits into. */
+#define MAX_PARTS 256
+
+/* How many ranges 0..n splits into on jobs threads: a few per thread, so that uneven work
+ * evens out, none shorter than smallest unless there is only one (threads.py ranges). */
+static int64_t parts_of(int64_t n, int32_t jobs, int64_t smallest)
+{
+    if (jobs <= 1 || n <= 0)
+        return 1;
+    int64_t parts = n / (smallest > 0 ? smallest : 1), most = 4 * (int64_t)jobs;
+    parts = MIN(parts, MIN(most, MAX_PARTS));
+    return parts < 1 ? 1 : parts;
+}
+
+static inline int64_t edge(int64_t n, int64_t parts, int64_t k)
+{
+    return n * k / parts;
+}
+
+/* ---- per-shape passes (kernels.c, shape_bounds.inc) ---- */
+
+#define SHAPE_PASSES(isa) \
+    void primary_shapes_##isa(const double *, const uint8_t *, int64_t, const double *, double, double, double, \
+                              double, double, double *, double *, double *); \
+    void shadow_shapes_##isa(const double *, const uint8_t *, int64_t, const double *, double, double, double, \
+                             double, double, double, double, const double *, double, double *, double *, double *, \
+                             double *); \
+    void flat_items_##isa(const int32_t *, int64_t, const double *, const double *, const double *, double *); \
+    void cone_items_##isa(const int32_t *, int64_t, const double *, const double *, const double *, double *);
+SHAPE_PASSES(base)
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+SHAPE_PASSES(avx2)
+#define PICK(b, name) ((b)->avx2 ? name##_avx2 : name##_base)
+#else
+#define PICK(b, name) name##_base
+#endif
+
+int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
+                  int32_t *node, int64_t *count_out);
+void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items, const double *keys,
+               double *node_keys, int64_t lo, int64_t hi);
+
+/* A bundle's shape pass over shapes a..b. */
+static void shape_range(const Bundle *b, int64_t a, int64_t e)
+{
+    if (b->pass == PASS_PRIMARY)
+        PICK(b, primary_shapes)(b->bnd + B_COLUMNS * a, b->ok + a, e - a, b->apex, b->dmin, b->dmax, b->u, b->tiny,
+                                b->overflow, b->radius + a, b->floor + a, b->pc + PC_COLUMNS * a);
+    else if (b->pass == PASS_SHADOW)
+        PICK(b, shadow_shapes)(b->bnd + B_COLUMNS * a, b->ok + a, e - a, b->mid, b->half, b->magnitude, b->dmin,
+                               b->chord, b->u, b->tiny, b->overflow, b->unit, b->l_len, b->radius + a,
+                               b->behind != NULL ? b->behind + 3 * a : NULL, b->keys != NULL ? b->keys + 3 * a : NULL,
+                               b->point != NULL ? b->point + SK_COLUMNS * a : NULL);
+}
+
+static void shape_task(void *ctx, int64_t k)
+{
+    const Bundle *b = ctx;
+    int64_t parts = parts_of(b->n, b->jobs, b->chunk);
+    shape_range(b, edge(b->n, parts, k), edge(b->n, parts, k + 1));
+}
+
+/* Each shape's own cone or box, over a range of the tree's items (leaf order). */
+static void item_task(void *ctx, int64_t k)
+{
+    const Bundle *b = ctx;
+    int64_t n = b->items, parts = parts_of(n, b->jobs, b->chunk), a = edge(n, parts, k), e = edge(n, parts, k + 1);
+    const int32_t *items = b->tree.items + a;
+    if (b->kind == BVH_CONE)
+        PICK(b, cone_items)(items, e - a, b->bnd, b->radius, b->tree.frame, b->own + CI_COLUMNS * a);
+    else
+        PICK(b, flat_items)(items, e - a, b->bnd, b->radius, b->tree.frame, b->own + BX_COLUMNS * a);
+}
+
+/* ---- refits: subtrees side by side, then the nodes above them ---- */
+
+typedef struct {
+    const Bundle *b;
+    int64_t below[MAX_PARTS][2];  /* node ranges of disjoint subtrees, largest first */
+    int64_t count;
+} Subtrees;
+
+static void refit_range(const Bundle *b, int64_t lo, int64_t hi)
+{
+    const double *keys = b->kind == BVH_FLAT ? b->keys : b->point;
+    bvh_refit(&b->tree, b->floor, b->kind, b->box, b->own, keys, b->node_keys, lo, hi);
+}
+
+static void refit_task(void *ctx, int64_t k)
+{
+    const Subtrees *s = ctx;
+    refit_range(s->b, s->below[k][0], s->below[k][1]);
+}
+
+/* At least want disjoint subtrees (fewer when the tree has fewer leaves) and the nodes
+ * above them, children before parents (bvh.py Tree.subtrees, the same split). Nodes are
+ * depth first: node at's left child is at + 1, its right child node[at][0] (inner: count
+ * node[at][1] is 0). */
+static void subtrees(const int32_t *node, int64_t nodes, int64_t want, Subtrees *s, int64_t *above, int64_t *n_above)
+{
+    s->count = 0;
+    *n_above = 0;
+    if (nodes <= 0)
+        return;
+    s->below[s->count][0] = 0;
+    s->below[s->count++][1] = nodes;
+    while (s->count < MIN(want, MAX_PARTS)) {
+        int64_t pick = -1;
+        for (int64_t i = 0; i < s->count; i++) {
+            int64_t lo = s->below[i][0], hi = s->below[i][1];
+            if (node[2 * lo + 1] == 0 && hi - lo > 1 &&
+                (pick < 0 || hi - lo > s->below[pick][1] - s->below[pick][0]))
+                pick = i;
+        }
+        if (pick < 0)
+            break;
+        int64_t lo = s->below[pick][0], hi = s->below[pick][1], right = node[2 * lo];
+        s->below[pick][0] = lo + 1;
+        s->below[pick][1] = right;
+        s->below[s->count][0] = right;
+        s->below[s->count++][1] = hi;
+        above[(*n_above)++] = lo;
+    }
+    for (int64_t i = 1; i < s->count; i++) {  /* largest first (insertion sort: a few ranges) */
+        int64_t lo = s->below[i][0], hi = s->below[i][1], j = i;
+        for (; j > 0 && s->below[j - 1][1] - s->below[j - 1][0] < hi - lo; j--) {
+            s->below[j][0] = s->below[j - 1][0];
+            s->below[j][1] = s->below[j - 1][1];
+        }
+        s->below[j][0] = lo;
+        s->below[j][1] = hi;
+    }
+}
+
+/* The bundle's items and refit, after its radii are known. */
+static void bundle_tree(Bundle *b, Team *team)
+{
+    int64_t parts = parts_of(b->items, b->jobs, b->chunk);
+    team_phase(team, item_task, b, parts);
+    Subtrees s = {.b = b};
+    int64_t above[MAX_PARTS], n_above;
+    subtrees(b->tree.node, b->tree.nodes, parts, &s, above, &n_above);
+    team_phase(team, refit_task, &s, s.count);
+    for (int64_t i = n_above - 1; i >= 0; i--)  /* parents after their children */
+        refit_range(b, above[i], above[i] + 1);
+}
+
+/* One bundle of rays' bounds: its shape pass (none: radius given), each shape's own cone
+ * or box, and the nodes' bounds (bvh.py Tree.refit, bounds.py). */
+void bundle_bounds(Bundle *b, Team *team)
+{
+    if (b->pass != PASS_NONE)
+        team_phase(team, shape_task, b, parts_of(b->n, b->jobs, b->chunk));
+    bundle_tree(b, team);
+}
+
+/* ---- the frame's set-up ---- */
+
+typedef struct {
+    Setup *s;
+    Bundle *primary;
+    int64_t parts;
+    int64_t on[MAX_PARTS];  /* shapes on per range of rows */
+} Tables;
+
+static void tables_task(void *ctx, int64_t k)
+{
+    Tables *t = ctx;
+    Setup *s = t->s;
+    int64_t a = edge(s->rows, t->parts, k), e = edge(s->rows, t->parts, k + 1);
+    t->on[k] = s->tables(s->values + PROP_WORDS * a, s->index + a, e - a, s->props, s->kinds, s->cam, s->tiny,
+                         s->sf + s->sf_row * a, s->si + SI_COLUMNS * a, s->bnd + B_COLUMNS * a, s->bounded + a,
+                         s->index_out + a, s->format);
+}
+
+/* Task 0 builds the tree, the others run the primary bundle's shape pass. */
+static void build_task(void *ctx, int64_t k)
+{
+    Tables *t = ctx;
+    Setup *s = t->s;
+    if (k == 0)
+        s->nodes = bvh_build(s->bnd, s->bounded, s->shapes, s->items, s->always, s->node, s->counts);
+    else
+        shape_task(t->primary, k - 1);
+}
+
+/* The shape tables of the object table's rows (datapath.inc shape_tables, in ranges of
+ * rows, each range's shapes then moved up behind the previous range's), the tree over
+ * them (kernels.c bvh_build) and, when primary is not NULL, the primary rays' bounds
+ * (its shape pass beside the build, then bundle_tree). Returns the shapes on, or -1 when
+ * the build could not allocate its working copies. */
+int64_t frame_setup(Setup *s, Bundle *primary, Team *team)
+{
+    Tables t = {.s = s, .primary = primary, .parts = parts_of(s->rows, s->jobs, s->chunk)};
+    team_phase(team, tables_task, &t, t.parts);
+    int64_t n = 0;
+    for (int64_t k = 0; k < t.parts; k++) {
+        int64_t a = edge(s->rows, t.parts, k), m = t.on[k];
+        if (a != n && m > 0) {  /* rows before a were off */
+            memmove(s->sf + s->sf_row * n, s->sf + s->sf_row * a, (size_t)(s->sf_row * m));
+            memmove(s->si + SI_COLUMNS * n, s->si + SI_COLUMNS * a, (size_t)m * SI_COLUMNS * sizeof *s->si);
+            memmove(s->bnd + B_COLUMNS * n, s->bnd + B_COLUMNS * a, (size_t)m * B_COLUMNS * sizeof *s->bnd);
+            memmove(s->bounded + n, s->bounded + a, (size_t)m);
+            memmove(s->index_out + n, s->index_out + a, (size_t)m * sizeof *s->index_out);
+        }
+        n += m;
+    }
+    s->shapes = n;
+    if (primary != NULL)
+        primary->n = n;
+    int64_t shape_parts = primary != NULL ? parts_of(n, primary->jobs, primary->chunk) : 0;
+    team_phase(team, build_task, &t, 1 + shape_parts);
+    if (s->nodes < 0)
+        return -1;
+    if (primary != NULL) {
+        primary->items = s->counts[0];
+        primary->tree.nodes = s->nodes;
+        bundle_tree(primary, team);
+    }
+    return n;
+}

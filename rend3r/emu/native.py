@@ -193,6 +193,7 @@ _PLAIN = {
     "team_end": (None, [c_void_p]),
     "frame_setup": (c_int64, [POINTER(Setup), POINTER(Bundle), c_void_p]),
     "bundle_bounds": (None, [POINTER(Bundle), c_void_p]),
+    "team_chunks": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_int64, c_void_p, c_int64]),
 }
 _PER_ISA = {  # name: (restype, argtypes); each exists once per instruction set (double lanes)
     "primary_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,

@@ -25,8 +25,8 @@ never changes a pixel; :mod:`.reference` is the plain renderer the tests compare
 from __future__ import annotations
 
 import math
-from ctypes import byref, pointer
-from dataclasses import dataclass, replace
+from ctypes import addressof, byref, pointer
+from dataclasses import dataclass
 from time import perf_counter
 from typing import Callable
 
@@ -48,13 +48,9 @@ from .stats import FrameStats
 Progress = Callable[[float], None]
 #: Pixels per band: bounds the per-pixel working arrays (about 100 bytes per pixel).
 BAND_PIXELS = native.BAND_LIMIT
-#: Smallest chunk of pixels handed to a thread.
+#: Smallest chunk of pixels handed to a thread, and the most chunks a pass takes per thread.
 MIN_CHUNK = 1 << 12
-#: With several threads, a frame of one band is split into a band per thread (each set up
-#: and rendered whole on its thread) when it has at least this many pixels per shape; with
-#: more shapes the per-shape set-up each band repeats would cost more than it saves, and
-#: the band's steps are split over the threads instead.
-PIXELS_PER_SHAPE = 16
+CHUNKS_PER_JOB = 32
 _CHANNELS = ((11, 31), (5, 63), (0, 31))  # RGB565: (shift, largest value) per channel
 
 
@@ -89,26 +85,21 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
                  progress: Progress | None = None) -> tuple[Frame, FrameStats]:
     """Render the scene as the raytracer sees it; returns the frame and its stats."""
     start = perf_counter()
-    fr = set_up(scene, options)
-    w, h, n_pix = options.width, options.height, options.pixels
-    st = FrameStats(number=number, pixels=n_pix, shapes=len(fr.sf), lights=len(fr.lights), rays=n_pix)
-    rgb, depth, prov = np.empty(n_pix, np.uint16), np.empty(n_pix, np.float32), np.empty(n_pix, np.int32)
-    if not len(fr.sf):  # else every band's finish pass sets every pixel
-        rgb[:], depth[:], prov[:] = options.background, np.inf, -1
-    else:
-        rows = max(1, BAND_PIXELS // w)
-        if fr.jobs > 1 and len(fr.sf) * PIXELS_PER_SHAPE <= n_pix:  # a band per thread at least
-            rows = min(rows, -(-h // fr.jobs))
-        bands = [(row0, min(h, row0 + rows)) for row0 in range(0, h, rows)]
-        primary = fr.primary  # a grid camera's bands share one set of primary bounds
-        # several bands: side by side on the threads, each single-threaded; one: its steps split
-        one = replace(fr, jobs=1) if len(bands) > 1 else fr
-        done = (lambda k: progress(bands[k][1] / h)) if progress is not None else None
-        for band in threads.each(fr.jobs if len(bands) > 1 else 1, [
-                lambda row0=row0, row1=row1: _band(one, options, row0, row1, rgb[row0 * w:row1 * w],
-                                                   depth[row0 * w:row1 * w], prov[row0 * w:row1 * w], primary)
-                for row0, row1 in bands], done):
-            _add(st, band)
+    with threads.team(options.jobs or threads.available_cores()):  # the frame's every pass splits over it
+        fr = set_up(scene, options)
+        w, h, n_pix = options.width, options.height, options.pixels
+        st = FrameStats(number=number, pixels=n_pix, shapes=len(fr.sf), lights=len(fr.lights), rays=n_pix)
+        rgb, depth, prov = np.empty(n_pix, np.uint16), np.empty(n_pix, np.float32), np.empty(n_pix, np.int32)
+        if not len(fr.sf):  # else every band's finish pass sets every pixel
+            rgb[:], depth[:], prov[:] = options.background, np.inf, -1
+        else:
+            rows = max(1, BAND_PIXELS // w)
+            for row0 in range(0, h, rows):
+                row1 = min(h, row0 + rows)
+                _add(st, _band(fr, options, row0, row1, rgb[row0 * w:row1 * w], depth[row0 * w:row1 * w],
+                               prov[row0 * w:row1 * w], fr.primary))
+                if progress is not None:
+                    progress(row1 / h)
     st.seconds = perf_counter() - start
     return Frame(number, rgb.reshape(h, w), depth.reshape(h, w), prov.reshape(h, w)), st
 
@@ -224,17 +215,18 @@ def _light_rows(lights: list[Light], dtype: np.dtype) -> np.ndarray:
     return rows
 
 
-def _run(jobs: int, n: int, fn: Callable[..., object], block: object, last: np.ndarray | int,
-         smallest: int = MIN_CHUNK) -> np.ndarray | None:
-    """``fn(block, k0, k1, last)`` over chunks of 0..n (``smallest`` long at least) on ``jobs``
-    threads. An array ``last`` (e.g. counters) is copied for each chunk and the copies are
-    returned stacked; an int (an address) is passed to every chunk as it is."""
-    chunks = threads.ranges(n, jobs, smallest)
-    copies = isinstance(last, np.ndarray)
-    outs = _own_lines(last, len(chunks)) if copies else None
-    ref = byref(block)
-    threads.each(jobs, [lambda k=k, a=a, b=b: fn(ref, a, b, address(outs[k]) if copies else last)
-                        for k, (a, b) in enumerate(chunks)])
+def _run(jobs: int, n: int, fn: Callable[..., object], block: object, last: np.ndarray,
+         smallest: int | None = None) -> np.ndarray:
+    """The pixel kernel ``fn(block, k0, k1, out)`` over chunks of 0..n (``smallest`` long at
+    least, MIN_CHUNK if None; at most CHUNKS_PER_JOB a thread) on a team of ``jobs`` threads (csrc/setup.c
+    team_chunks; a thread takes the next chunk in a microsecond, so many small chunks even
+    out uneven ones), each chunk adding to its own copy of the report row ``last``;
+    returns the copies stacked."""
+    parts = 1 if jobs <= 1 else max(1, min(CHUNKS_PER_JOB * jobs, n // (smallest or MIN_CHUNK)))
+    outs = _own_lines(last, parts)
+    with threads.team(jobs) as team:
+        native.library().team_chunks(team, native.function_address(fn), addressof(block), n, len(outs),
+                                     address(outs[0]), outs.strides[0])
     return outs
 
 

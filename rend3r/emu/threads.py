@@ -107,19 +107,33 @@ def each(jobs: int, calls: list[Callable[[], T]], done: Callable[[int], None] | 
     return results
 
 
+_LED = threading.local()  # the team this thread leads, while it does
+
+
 @contextmanager
 def team(jobs: int) -> Iterator[int]:
-    """A team of threads for a compiled call (csrc/team.h): ``jobs - 1`` helpers join it
+    """A team of threads for compiled calls (csrc/team.h): ``jobs - 1`` helpers join it
     while the block runs, and the address yielded is passed to the calls that lead it. The
-    helpers may join late (the calls never wait for them) and leave when the block ends."""
+    helpers may join late (the calls never wait for them), wait spinning between the calls
+    (so that a call hands work over in a microsecond) and leave when the block ends. Inside
+    a team this thread leads, the same team is yielded again."""
+    led = getattr(_LED, "team", None)
+    if led is not None:
+        yield led
+        return
     lib = native.library()
-    state = np.zeros(lib.team_bytes(), np.uint8)  # kept alive by the calls below, even for a late helper
-    at = native.address(state)
+    state = np.zeros(_team_bytes(), np.uint8)  # kept alive by the calls below, even for a late helper
+    at = _LED.team = native.address(state)
     members = [_helpers(jobs - 1).submit(lambda: lib.team_member(native.address(state))) for _ in range(jobs - 1)]
     try:
         yield at
     finally:
+        _LED.team = None
         lib.team_end(at)
         for member in members:
             member.cancel()  # one not started has nothing to do
 
+
+@lru_cache(maxsize=1)
+def _team_bytes() -> int:
+    return native.library().team_bytes()

@@ -19,7 +19,7 @@ from rend3r.emu.frame import Frame
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.processor import execute
 from rend3r.emu.quirks import apply_quirks, quirk_names
-from rend3r.emu import reference
+from rend3r.emu import bounds, raytracer, reference
 from rend3r.emu.raytracer import render_frame
 from rend3r.emu.reference import render_reference
 from rend3r.emu.scene import Scene
@@ -149,9 +149,14 @@ def check(words: list[int], options: EmuOptions) -> None:
     engine, stats = render_frame(scene, options)
     event(f"pixels hit: {'none' if not stats.hits else 'some' if stats.hits < options.pixels // 4 else 'many'}")
     assert_same(engine, render_reference(scene, options))
-    for jobs in (1, 3):  # one band on one thread; a band per thread
-        split, _ = render_frame(scene, replace(options, jobs=jobs))
-        assert_same(engine, split)
+    chunks = raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK
+    raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK = 16, 2  # tiny chunks: every pass split over the team
+    try:
+        for jobs in (1, 3):  # one thread; a team of three
+            split, _ = render_frame(scene, replace(options, jobs=jobs))
+            assert_same(engine, split)
+    finally:
+        raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK = chunks
 
 
 scene_args = (camera, st.lists(light, max_size=3), st.lists(shape, min_size=1, max_size=7),

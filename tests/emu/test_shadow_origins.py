@@ -64,7 +64,7 @@ def test_shadow_origins_match_a_plain_computation(precision, light_at, monkeypat
     monkeypatch.setattr(raytracer, "_report_origins", report)
     real_run = raytracer._run
 
-    def run(jobs, n, fn, block, last, smallest=raytracer.MIN_CHUNK):
+    def run(jobs, n, fn, block, last, smallest=None):
         if isinstance(block, native.LightPass) and getattr(fn, "__name__", "").startswith("shadow_origins"):
             seen.append(expected(block, ar, native.dtype(ar)))
         return real_run(jobs, n, fn, block, last, smallest)

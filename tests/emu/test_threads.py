@@ -61,3 +61,26 @@ def test_work_handed_out_from_a_helper_does_not_wait_for_itself():
             "inner = lambda: threads.each(2, [lambda k=k: k for k in range(6)])\n"
             "assert threads.each(2, [inner, inner]) == [list(range(6))] * 2\n")
     subprocess.run([sys.executable, "-c", code], check=True, timeout=30)
+
+
+def test_a_team_is_led_once_per_thread_and_ends_with_its_block():
+    """Inside a team this thread leads, calls get the same team; another thread leads its
+    own. After an error in the block the helpers leave: the process exits (a helper left
+    spinning would keep it alive), in a process of its own."""
+    with threads.team(2) as outer:
+        with threads.team(3) as inner:
+            assert inner == outer
+        assert threads.each(2, [lambda: None, lambda: None]) == [None, None]  # a busy helper: the caller takes both
+        seen: list[int] = []
+
+        def lead() -> None:
+            with threads.team(2) as own:
+                seen.append(own)
+
+        other = threading.Thread(target=lead)
+        other.start()
+        other.join()
+        assert seen and seen[0] != outer
+    code = ("from rend3r.emu import threads\n"
+            "try:\n    with threads.team(2):\n        raise KeyError\nexcept KeyError:\n    pass\n")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=30)

@@ -51,30 +51,35 @@ static inline void team_wait(int64_t *spins)
     }
 }
 
-/* Takes the next tasks of phase p until none is left. */
-static void team_take(Team *t, int64_t p)
+/* Takes tasks of phase p (its slot ph, read after p was seen released) until none is
+ * left or the phase is over. */
+static void team_take(Team *t, int64_t p, TeamPhase *ph)
 {
-    TeamPhase *ph = &t->at[p];
-    for (;;) {
-        int64_t k = atomic_fetch_add_explicit(&ph->next, 1, memory_order_relaxed);
-        if (k >= ph->tasks)
-            return;
-        ph->fn(ph->ctx, k);
-        atomic_fetch_add_explicit(&ph->finished, 1, memory_order_release);
+    TeamTask fn = ph->fn;
+    void *ctx = ph->ctx;
+    int64_t tasks = ph->tasks;
+    uint64_t v = atomic_load_explicit(&t->claim, memory_order_acquire);
+    while ((int64_t)(v >> 32) == p && (int64_t)(v & 0xFFFFFFFFu) < tasks) {
+        if (atomic_compare_exchange_weak_explicit(&t->claim, &v, v + 1, memory_order_acq_rel,
+                                                  memory_order_acquire)) {
+            fn(ctx, (int64_t)(v & 0xFFFFFFFFu));
+            atomic_fetch_add_explicit(&ph->finished, 1, memory_order_release);
+            v = atomic_load_explicit(&t->claim, memory_order_acquire);
+        }
     }
 }
 
-/* A member: takes tasks of every phase released until the team ends. */
+/* A member: takes tasks of each phase released until the team ends. */
 void team_member(Team *t)
 {
-    int64_t seen = 0, spins = 0;
+    int64_t done = 0, spins = 0;
     for (;;) {
-        int64_t released = atomic_load_explicit(&t->released, memory_order_acquire);
-        if (released == TEAM_ENDED)
+        int64_t p = atomic_load_explicit(&t->released, memory_order_acquire);
+        if (p == TEAM_ENDED)
             return;
-        if (released > seen) {
-            for (; seen < released; seen++)
-                team_take(t, seen);
+        if (p != done) {
+            team_take(t, p, &t->ring[p % TEAM_RING]);
+            done = p;
             spins = 0;
         } else {
             team_wait(&spins);
@@ -90,20 +95,20 @@ void team_end(Team *t)
 /* Runs tasks 0..tasks of fn on the team; returns once every one has finished. */
 static void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
 {
-    int64_t p = atomic_load_explicit(&t->released, memory_order_relaxed);
-    if (p >= TEAM_PHASES || tasks <= 1) {  /* out of phases (or one task): this thread alone */
+    if (tasks <= 1) {  /* nothing to share */
         for (int64_t k = 0; k < tasks; k++)
             fn(ctx, k);
         return;
     }
-    TeamPhase *ph = &t->at[p];
+    int64_t p = ++t->phases;
+    TeamPhase *ph = &t->ring[p % TEAM_RING];
     ph->fn = fn;
     ph->ctx = ctx;
     ph->tasks = tasks;
-    atomic_store_explicit(&ph->next, 0, memory_order_relaxed);
     atomic_store_explicit(&ph->finished, 0, memory_order_relaxed);
-    atomic_store_explicit(&t->released, p + 1, memory_order_release);
-    team_take(t, p);
+    atomic_store_explicit(&t->claim, (uint64_t)p << 32, memory_order_release);
+    atomic_store_explicit(&t->released, p, memory_order_release);
+    team_take(t, p, ph);
     int64_t spins = 0;
     while (atomic_load_explicit(&ph->finished, memory_order_acquire) < tasks)
         team_wait(&spins);
@@ -129,6 +134,33 @@ static int64_t parts_of(int64_t n, int32_t jobs, int64_t smallest)
 static inline int64_t edge(int64_t n, int64_t parts, int64_t k)
 {
     return n * k / parts;
+}
+
+/* ---- a pixel kernel's chunks (raytracer.py _run) ---- */
+
+/* A pixel kernel of datapath.inc (directions, nearest, light_pass, shadow_origins): its
+ * block, pixels a..b, and the report row it adds to. */
+typedef void (*ChunkFn)(const void *block, int64_t a, int64_t b, void *out);
+
+typedef struct {
+    ChunkFn fn;
+    const void *block;
+    int64_t n, parts, stride;
+    char *outs;
+} Chunks;
+
+static void chunk_task(void *ctx, int64_t k)
+{
+    const Chunks *c = ctx;
+    c->fn(c->block, edge(c->n, c->parts, k), edge(c->n, c->parts, k + 1), c->outs + c->stride * k);
+}
+
+/* fn over 0..n in parts chunks on the team, chunk k reporting into the row at outs + k
+ * stride bytes (each its own cache lines: raytracer.py _own_lines). */
+void team_chunks(Team *team, ChunkFn fn, const void *block, int64_t n, int64_t parts, void *outs, int64_t stride)
+{
+    Chunks c = {fn, block, n, parts < 1 ? 1 : parts, stride, outs};
+    team_phase(team, chunk_task, &c, c.parts);
 }
 
 /* ---- per-shape passes (kernels.c, shape_bounds.inc) ---- */

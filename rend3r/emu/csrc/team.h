@@ -5,10 +5,16 @@
  * The calling thread leads: it releases phases one after another, each a list of tasks,
  * takes tasks itself and waits until every task of the phase has finished. Members are
  * threads that the Python side starts beside the call (threads.team: its helpers call
- * team_member); each takes the next task not yet taken of every phase released, and
+ * team_member); each takes the next task not yet taken of the phase released last, and
  * returns when the leader ends the team (team_end). A member may join late or never: the
  * leader never waits for one to arrive, only for the tasks taken to finish. Tasks write
  * disjoint outputs, so results never depend on which thread ran which task.
+ *
+ * A task is claimed by one compare-and-swap on claim, which holds the phase number with
+ * the next task: a member that read a phase's slot late (the leader has moved on and may
+ * be rewriting it) fails that swap, as the phase number in claim has changed, and never
+ * runs a task of a phase that is over. A phase's slot is rewritten TEAM_RING phases
+ * later, when every task of it has finished (the leader waited for them).
  */
 #ifndef REND3R_TEAM_H
 #define REND3R_TEAM_H
@@ -23,30 +29,30 @@
 #include <stdatomic.h>
 #endif
 
-/* Phases a team may release; a leader that would need more runs the rest itself. */
-#define TEAM_PHASES 16
+/* A phase's description lives in a ring slot until the phase TEAM_RING later reuses it. */
+#define TEAM_RING 4
 #define TEAM_ENDED INT64_MAX
 
 typedef void (*TeamTask)(void *ctx, int64_t k);
+
+#if TEAM_SOLO
+#define TEAM_ATOMIC(t) t
+#else
+#define TEAM_ATOMIC(t) _Atomic t
+#endif
 
 typedef struct {
     TeamTask fn;
     void *ctx;
     int64_t tasks;
-#if TEAM_SOLO
-    int64_t next, finished;
-#else
-    _Atomic int64_t next, finished;
-#endif
+    TEAM_ATOMIC(int64_t) finished;
 } TeamPhase;
 
 typedef struct {
-#if TEAM_SOLO
-    int64_t released;
-#else
-    _Atomic int64_t released;  /* phases released so far; TEAM_ENDED once the team has ended */
-#endif
-    TeamPhase at[TEAM_PHASES];
+    TEAM_ATOMIC(int64_t) released;  /* the phase released last (1, 2, ...; 0: none yet), TEAM_ENDED once ended */
+    TEAM_ATOMIC(uint64_t) claim;    /* that phase << 32 | its next task not yet taken */
+    int64_t phases;                 /* the leader's count of phases */
+    TeamPhase ring[TEAM_RING];
 } Team;
 
 #endif

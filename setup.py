@@ -12,9 +12,10 @@ from pathlib import Path
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
-#: IEEE semantics the emulator depends on: no fused multiply-adds, no fast-math.
+#: IEEE semantics the emulator depends on: no fused multiply-adds, no fast-math; POSIX
+#: threads for the teams (csrc/team.c).
 UNIX_FLAGS = ["-std=c11", "-O3", "-ffp-contract=off", "-fno-fast-math", "-fno-math-errno", "-Wall", "-Wextra",
-              "-Wno-psabi"]
+              "-Wno-psabi", "-pthread"]
 MSVC_FLAGS = ["/O2", "/fp:precise"]
 CSRC = Path("rend3r/emu/csrc")
 
@@ -27,6 +28,7 @@ class BuildKernels(build_ext):
         flags = MSVC_FLAGS if self.compiler.compiler_type == "msvc" else UNIX_FLAGS
         for ext in self.extensions:
             ext.extra_compile_args = flags
+            ext.extra_link_args = ["-pthread"] if flags is UNIX_FLAGS else []
         if self.compiler.compiler_type == "unix":
             self.compiler.compile = self._compile_parallel
         super().build_extensions()
@@ -52,7 +54,8 @@ setup(
     ext_modules=[
         Extension(
             "rend3r.emu._kernels",
-            sources=[str(CSRC / "kernels.c"), str(CSRC / "setup.c"), *sorted(str(p) for p in (CSRC / "instances").glob("*.c"))],
+            sources=[*(str(CSRC / name) for name in ("kernels.c", "setup.c", "team.c")),
+                     *sorted(str(p) for p in (CSRC / "instances").glob("*.c"))],
             depends=[str(p) for p in sorted(CSRC.glob("*.[hi]*"))],
         )
     ],

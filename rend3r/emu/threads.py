@@ -4,11 +4,14 @@ Kernels release the GIL (they are called through ctypes), so ranges of pixels, p
 or shapes run in parallel on ``--jobs`` threads. Every range is computed the same way
 whatever the split, so results never depend on the thread count.
 
-The calling thread takes part: with ``jobs`` threads it runs calls itself beside
-``jobs - 1`` helpers, each thread taking the next call not yet taken. A caller that only
-waited while ``jobs`` helpers worked left its core idle, and Linux woke the helpers onto
-one core (measured here: the two helpers of a 65,536-sphere frame took turns on one CPU
-while the other idled, and two threads ran no faster than one).
+A frame's passes run on a :func:`team`: native threads of the kernels' pool that join
+it and wait spinning between the compiled calls (``csrc/team.h``), so that a pass of a
+few tens of microseconds still splits. Other work splits over Python threads with
+:func:`each`. In both the calling thread takes part: with ``jobs`` threads it works
+beside ``jobs - 1`` others, each thread taking the next range or call not yet taken. A
+caller that only waited while ``jobs`` helpers worked left its core idle, and Linux woke
+the helpers onto one core (measured here: the two helpers of a 65,536-sphere frame took
+turns on one CPU while the other idled, and two threads ran no faster than one).
 """
 
 from __future__ import annotations
@@ -112,26 +115,26 @@ _LED = threading.local()  # the team this thread leads, while it does
 
 @contextmanager
 def team(jobs: int) -> Iterator[int]:
-    """A team of threads for compiled calls (csrc/team.h): ``jobs - 1`` helpers join it
-    while the block runs, and the address yielded is passed to the calls that lead it. The
-    helpers may join late (the calls never wait for them), wait spinning between the calls
-    (so that a call hands work over in a microsecond) and leave when the block ends. Inside
-    a team this thread leads, the same team is yielded again."""
+    """A team of threads for compiled calls (csrc/team.h): up to ``jobs - 1`` native
+    threads of the kernels' pool join it while the block runs, and the address yielded is
+    passed to the calls that lead it. They never take the GIL: they join as they wake (the
+    calls never wait for them), wait spinning between the calls, so that a call hands work
+    over in a microsecond, and leave when the block ends. Inside a team this thread leads,
+    the same team is yielded again; while another thread's team is open the pool serves
+    that one, and this one's calls run on this thread alone."""
     led = getattr(_LED, "team", None)
     if led is not None:
         yield led
         return
     lib = native.library()
-    state = np.zeros(_team_bytes(), np.uint8)  # kept alive by the calls below, even for a late helper
+    state = np.zeros(_team_bytes(), np.uint8)
     at = _LED.team = native.address(state)
-    members = [_helpers(jobs - 1).submit(lambda: lib.team_member(native.address(state))) for _ in range(jobs - 1)]
+    lib.team_open(at, jobs - 1)
     try:
         yield at
     finally:
         _LED.team = None
-        lib.team_end(at)
-        for member in members:
-            member.cancel()  # one not started has nothing to do
+        lib.team_close(at)  # returns once no member is inside it: then state may go
 
 
 @lru_cache(maxsize=1)

@@ -88,8 +88,8 @@ def test_tables_split_over_threads_are_the_same(rows, seed, jobs):
 
 def test_teams_led_side_by_side_on_busy_helpers():
     """Two frames set up at once on the two threads of threads.each, each leading a team of
-    two whose helper is the other frame's thread (busy): a team never waits for a member,
-    so each set-up runs on its own thread and gets the same bits as with one job."""
+    two: the pool serves one team at a time and a team never waits for a member, so the
+    other set-up runs on its own thread; both get the same bits as with one job."""
     from rend3r.emu import bounds, threads
 
     rng = np.random.default_rng(7)

@@ -5,10 +5,13 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 import pytest
 
 from rend3r.emu import threads
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_results_and_progress_come_in_order_on_the_calling_thread():
@@ -65,12 +68,11 @@ def test_work_handed_out_from_a_helper_does_not_wait_for_itself():
 
 def test_a_team_is_led_once_per_thread_and_ends_with_its_block():
     """Inside a team this thread leads, calls get the same team; another thread leads its
-    own. After an error in the block the helpers leave: the process exits (a helper left
-    spinning would keep it alive), in a process of its own."""
+    own meanwhile (the pool serves the first, so the second's calls run alone). After an
+    error in the block the team ends: the process exits, in a process of its own."""
     with threads.team(2) as outer:
         with threads.team(3) as inner:
             assert inner == outer
-        assert threads.each(2, [lambda: None, lambda: None]) == [None, None]  # a busy helper: the caller takes both
         seen: list[int] = []
 
         def lead() -> None:
@@ -84,3 +86,25 @@ def test_a_team_is_led_once_per_thread_and_ends_with_its_block():
     code = ("from rend3r.emu import threads\n"
             "try:\n    with threads.team(2):\n        raise KeyError\nexcept KeyError:\n    pass\n")
     subprocess.run([sys.executable, "-c", code], check=True, timeout=30)
+
+
+def test_a_forked_child_starts_its_own_team_threads():
+    """The pool's threads do not survive a fork: a child that renders with two jobs starts
+    its own, and gets the frames its parent gets with one."""
+    code = (
+        "import os, sys\n"
+        "sys.path.insert(0, 'benchmarks')\n"
+        "import walls\n"
+        "from rend3r.emu.options import EmuOptions\n"
+        "from rend3r.emu.run import run_program\n"
+        "from rend3r.emu import bounds, raytracer\n"
+        "raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK = 16, 8  # every pass split\n"
+        "w = walls.wall(256, 1)\n"
+        "frame = lambda j: run_program(w.words, EmuOptions(precision='fp32', jobs=j, width=64, height=48)).frames[0]\n"
+        "one = frame(1).rgb565.tobytes()\n"
+        "assert frame(2).rgb565.tobytes() == one\n"
+        "pid = os.fork()\n"
+        "if pid == 0:\n"
+        "    os._exit(0 if frame(2).rgb565.tobytes() == one else 1)\n"
+        "assert os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]) == 0\n")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=60, cwd=ROOT)

@@ -1,14 +1,15 @@
-/* A team of threads inside one compiled call (setup.c), so that passes of a few tens of
- * microseconds split over the cores: a hand-off through Python (a helper's wake-up, then
- * the GIL) costs about as much as such a pass.
+/* A team of threads inside compiled calls (team.c; setup.c runs a frame's passes on one),
+ * so that passes of a few tens of microseconds split over the cores: a hand-off through
+ * a Python thread (its wake-up, then the GIL) costs about as much as such a pass.
  *
- * The calling thread leads: it releases phases one after another, each a list of tasks,
- * takes tasks itself and waits until every task of the phase has finished. Members are
- * threads that the Python side starts beside the call (threads.team: its helpers call
- * team_member); each takes the next task not yet taken of the phase released last, and
- * returns when the leader ends the team (team_end). A member may join late or never: the
- * leader never waits for one to arrive, only for the tasks taken to finish. Tasks write
- * disjoint outputs, so results never depend on which thread ran which task.
+ * The thread that opens a team leads it (team_open, team_close; threads.py team keeps
+ * one open while a frame renders): it releases phases one after another, each a list of
+ * tasks, takes tasks itself and waits until every task of the phase has finished. The
+ * members are native threads of a pool (team.c), which wait spinning for the next phase
+ * and take the next task not yet taken of the phase released last. A member may join
+ * late or never: the leader never waits for one to arrive, only for the tasks taken to
+ * finish. Tasks write disjoint outputs, so results never depend on which thread ran which
+ * task.
  *
  * A task is claimed by one compare-and-swap on claim, which holds the phase number with
  * the next task: a member that read a phase's slot late (the leader has moved on and may
@@ -22,7 +23,7 @@
 #include <stdint.h>
 
 #if defined(__STDC_NO_ATOMICS__) || defined(_WIN32)
-#define TEAM_SOLO 1  /* no C11 atomics (or no sched_yield): members return at once, the leader does every task */
+#define TEAM_SOLO 1  /* no C11 atomics or POSIX threads: the leader does every task */
 #else
 #define TEAM_SOLO 0
 #include <sched.h>
@@ -54,5 +55,9 @@ typedef struct {
     int64_t phases;                 /* the leader's count of phases */
     TeamPhase ring[TEAM_RING];
 } Team;
+
+/* Runs tasks 0..tasks of fn on team t (the caller leads it); returns once every one has
+ * finished (team.c). */
+void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks);
 
 #endif

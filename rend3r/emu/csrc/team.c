@@ -1,0 +1,210 @@
+/* A team of threads inside compiled calls (team.h): the protocol, and the pool of native
+ * threads that join teams.
+ *
+ * The members are threads of this library, not Python threads: they never take the GIL,
+ * so joining a team and leaving it costs the leader nothing but a wake-up call. They are
+ * started the first time a team asks for them and then sleep between teams.
+ */
+#define _POSIX_C_SOURCE 200809L  /* pthread_sigmask, sched_yield under -std=c11 */
+
+#include <stdint.h>
+
+#include "team.h"
+
+int64_t team_bytes(void)
+{
+    return (int64_t)sizeof(Team);
+}
+
+#if TEAM_SOLO
+int32_t team_open(Team *t, int32_t members)
+{
+    (void)t;
+    (void)members;
+    return 0;
+}
+
+void team_close(Team *t)
+{
+    t->released = TEAM_ENDED;
+}
+
+void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
+{
+    (void)t;
+    for (int64_t k = 0; k < tasks; k++)
+        fn(ctx, k);
+}
+#else
+#include <pthread.h>
+#include <signal.h>
+
+/* Waits a little (the other threads run on other cores), then yields the core: a team of
+ * more threads than cores must not spin against its own leader. */
+static inline void team_wait(int64_t *spins)
+{
+    if (++*spins < 2048) {
+#if defined(__x86_64__) || defined(__i386__)
+        __builtin_ia32_pause();
+#endif
+    } else {
+        sched_yield();
+    }
+}
+
+/* Takes tasks of phase p (its slot ph, read after p was seen released) until none is
+ * left or the phase is over. */
+static void team_take(Team *t, int64_t p, TeamPhase *ph)
+{
+    TeamTask fn = ph->fn;
+    void *ctx = ph->ctx;
+    int64_t tasks = ph->tasks;
+    uint64_t v = atomic_load_explicit(&t->claim, memory_order_acquire);
+    while ((int64_t)(v >> 32) == p && (int64_t)(v & 0xFFFFFFFFu) < tasks) {
+        if (atomic_compare_exchange_weak_explicit(&t->claim, &v, v + 1, memory_order_acq_rel,
+                                                  memory_order_acquire)) {
+            fn(ctx, (int64_t)(v & 0xFFFFFFFFu));
+            atomic_fetch_add_explicit(&ph->finished, 1, memory_order_release);
+            v = atomic_load_explicit(&t->claim, memory_order_acquire);
+        }
+    }
+}
+
+/* A member: takes tasks of each phase released until the team ends. */
+static void team_member(Team *t)
+{
+    int64_t done = 0, spins = 0;
+    for (;;) {
+        int64_t p = atomic_load_explicit(&t->released, memory_order_acquire);
+        if (p == TEAM_ENDED)
+            return;
+        if (p != done) {
+            team_take(t, p, &t->ring[p % TEAM_RING]);
+            done = p;
+            spins = 0;
+        } else {
+            team_wait(&spins);
+        }
+    }
+}
+
+void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
+{
+    if (tasks <= 1) {  /* nothing to share */
+        for (int64_t k = 0; k < tasks; k++)
+            fn(ctx, k);
+        return;
+    }
+    int64_t p = ++t->phases;
+    TeamPhase *ph = &t->ring[p % TEAM_RING];
+    ph->fn = fn;
+    ph->ctx = ctx;
+    ph->tasks = tasks;
+    atomic_store_explicit(&ph->finished, 0, memory_order_relaxed);
+    atomic_store_explicit(&t->claim, (uint64_t)p << 32, memory_order_release);
+    atomic_store_explicit(&t->released, p, memory_order_release);
+    team_take(t, p, ph);
+    int64_t spins = 0;
+    while (atomic_load_explicit(&ph->finished, memory_order_acquire) < tasks)
+        team_wait(&spins);
+}
+
+/* The pool: one team at a time. Its threads sleep on wake until a team is opened for
+ * them (the first `wanted` threads join it), count themselves in `inside` while they are
+ * members, and team_close waits until `inside` is 0 before the team's memory may go. */
+#define POOL_LIMIT 256
+static pthread_mutex_t pool_lock = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t pool_wake = PTHREAD_COND_INITIALIZER;
+static struct {
+    int32_t started;   /* threads started */
+    int32_t wanted;    /* of them, members of the open team */
+    int64_t opened;    /* teams opened so far (a thread joins each at most once) */
+    Team *team;        /* the open team, NULL: none */
+    int32_t inside;    /* threads inside the open team */
+    int32_t forks;     /* set up pthread_atfork once */
+} pool;
+
+static void *pool_thread(void *arg)
+{
+    int32_t index = (int32_t)(intptr_t)arg;
+    int64_t seen = 0;
+    pthread_mutex_lock(&pool_lock);
+    for (;;) {
+        while (!(pool.team != NULL && pool.opened != seen && index < pool.wanted))
+            pthread_cond_wait(&pool_wake, &pool_lock);
+        Team *t = pool.team;
+        seen = pool.opened;
+        pool.inside++;
+        pthread_mutex_unlock(&pool_lock);
+        team_member(t);
+        pthread_mutex_lock(&pool_lock);
+        pool.inside--;
+    }
+    return NULL;
+}
+
+/* In a forked child only the forking thread exists: the pool starts afresh. */
+static void pool_after_fork(void)
+{
+    pthread_mutex_init(&pool_lock, NULL);
+    pthread_cond_init(&pool_wake, NULL);
+    pool.started = pool.wanted = pool.inside = 0;
+    pool.team = NULL;
+}
+
+/* Opens team t (zeroed, team_bytes long) with up to `members` threads of the pool beside
+ * the caller, who leads it; returns how many were asked to join (0: the pool is serving
+ * another team, or could not start a thread). They join as they wake: the leader never
+ * waits for them. */
+int32_t team_open(Team *t, int32_t members)
+{
+    members = members < 0 ? 0 : members > POOL_LIMIT ? POOL_LIMIT : members;
+    pthread_mutex_lock(&pool_lock);
+    if (!pool.forks) {
+        pthread_atfork(NULL, NULL, pool_after_fork);
+        pool.forks = 1;
+    }
+    if (pool.team != NULL || members == 0) {
+        pthread_mutex_unlock(&pool_lock);
+        return 0;
+    }
+    sigset_t all, before;  /* the pool's threads block every signal: the process's threads take them */
+    sigfillset(&all);
+    pthread_sigmask(SIG_SETMASK, &all, &before);
+    while (pool.started < members) {
+        pthread_t thread;
+        pthread_attr_t attr;
+        pthread_attr_init(&attr);
+        pthread_attr_setdetachstate(&attr, PTHREAD_CREATE_DETACHED);
+        int failed = pthread_create(&thread, &attr, pool_thread, (void *)(intptr_t)pool.started);
+        pthread_attr_destroy(&attr);
+        if (failed)
+            break;
+        pool.started++;
+    }
+    pthread_sigmask(SIG_SETMASK, &before, NULL);
+    pool.wanted = members < pool.started ? members : pool.started;
+    pool.team = t;
+    pool.opened++;
+    pthread_cond_broadcast(&pool_wake);
+    int32_t joining = pool.wanted;
+    pthread_mutex_unlock(&pool_lock);
+    return joining;
+}
+
+/* Ends team t and returns once no thread of the pool is inside it. */
+void team_close(Team *t)
+{
+    atomic_store_explicit(&t->released, TEAM_ENDED, memory_order_release);
+    pthread_mutex_lock(&pool_lock);
+    if (pool.team == t) {
+        pool.team = NULL;
+        while (pool.inside > 0) {  /* members see the end within a wait's spin */
+            pthread_mutex_unlock(&pool_lock);
+            sched_yield();
+            pthread_mutex_lock(&pool_lock);
+        }
+    }
+    pthread_mutex_unlock(&pool_lock);
+}
+#endif

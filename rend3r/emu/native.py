@@ -101,7 +101,7 @@ class LightPass(Structure):
                 ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
                 ("first", c_int32), ("last", c_int32), ("behind", c_void_p),
                 ("l_hat", c_double * 3), ("l_len", c_double), ("radius", c_void_p), ("tree", Bvh), ("keys", c_void_p),
-                ("point_keys", c_void_p)]
+                ("point_keys", c_void_p), ("serial", c_int64)]
 
 
 class Setup(Structure):

@@ -24,6 +24,7 @@ never changes a pixel; :mod:`.reference` is the plain renderer the tests compare
 
 from __future__ import annotations
 
+import itertools
 import math
 from ctypes import addressof, byref, pointer
 from dataclasses import dataclass
@@ -358,6 +359,7 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
                           (*[((colour >> shift) & top) / top for shift, top in _CHANNELS],))
     lp.fixed, lp.shadows, lp.parallel = int(options.intensity_fixed), int(shadows), int(not point)
     lp.first, lp.last = int(k == 0), int(k == len(fr.lights) - 1)
+    lp.serial = next(_LIGHT_PASSES)  # its chunks' caches are kept per thread
     if shadows:  # lp points into the arrays of sb: they live until the pass is done
         sb = _shadow_bounds(fr, lp, light, hits, n_pix)
         lp.tree, lp.radius = sb.bounds.struct(), address(sb.radius)
@@ -374,6 +376,9 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
         st.skipped += int(c[native.OUT_SHADOW_RAYS]) * (n - 1) - int(c[native.OUT_TESTS])
     return c
 
+
+#: Numbers light passes (LightPass.serial) in the process.
+_LIGHT_PASSES = itertools.count(1)
 
 #: shadow_origins' output: bounding box of the points, largest magnitude, largest chord,
 #: points with a finite non-zero l, shortest |l|.

@@ -148,6 +148,8 @@ typedef struct {            /* one light over one band */
                                (shape_bounds.inc shadow_shapes, kernels.c bvh_refit) */
     const double *point_keys; /* point light (else NULL): per node PK_COLUMNS, its shapes' behind
                                  test's terms (cull.h point_behind4) */
+    int64_t serial;         /* this light pass's number in the process, its chunks' caches kept
+                               per thread (datapath.inc light_pass); 0: none kept */
 } LightPass;
 
 /* Property words per object table row (isa PROP_LIMIT). */

@@ -187,6 +187,7 @@ _PLAIN = {
                            c_void_p, c_void_p]),
     "pair_marks": (c_int64, [POINTER(Pairs), c_void_p]),
     "pair_apply": (None, [POINTER(Pairs), c_void_p, c_void_p]),
+    "pair_marks_team": (None, [c_void_p, POINTER(Pairs), c_int64, c_void_p, c_void_p]),
     "mark_rows": (c_int64, [c_void_p, c_int64, c_void_p, c_void_p]),
     "team_bytes": (c_int64, []),
     "team_open": (c_int32, [c_void_p, c_int32]),

@@ -232,39 +232,36 @@ def _marks() -> np.ndarray:
     return mark
 
 
-#: Pairs a thread takes at least (pair_marks takes about 2 ns a pair: below this, handing
-#: a range to another thread costs more than it saves).
-PAIR_CHUNK = 1 << 16
+#: Pairs a thread takes at least (pair_marks takes about 2 ns a pair: a range of these is
+#: about ten times what a team takes to hand it over).
+PAIR_CHUNK = 1 << 12
 
 
 def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, entry: int, wanted: np.ndarray,
                  table: ObjectTable, jobs: int) -> None:
     """Apply the SE/SD pairs at ``at`` (each writes prop then prop2; a write to a null
     property stores nothing) that ``wanted`` takes to ``table``, in compiled passes over
-    their words (csrc/kernels.c): the indices written (in ranges of pairs on ``jobs``
-    threads when there are many), then the writes, in order (threads that each took a
-    range of rows spent nearly as long reading every pair as one thread writing them all)."""
+    their words (csrc/kernels.c): the indices written (in ranges of pairs on a team of
+    ``jobs`` threads when there are many), then the writes, in order (threads that each
+    took a range of rows spent nearly as long reading every pair as one thread writing
+    them all)."""
     if not wanted.any():
         return
-
-    def pairs(a: int, b: int) -> native.Pairs:
-        return native.Pairs(address(words), len(words), address(at[a:]), b - a, address(_PAIR_FIELDS),
-                            None if tables is None else address(tables[a:]), entry, address(wanted),
-                            address(_SE_NULL))
-
+    pairs = native.Pairs(address(words), len(words), address(at), len(at), address(_PAIR_FIELDS),
+                         None if tables is None else address(tables), entry, address(wanted), address(_SE_NULL))
     lib, mark, top = native.library(), _marks(), -1
-    parts = threads.ranges(len(at), jobs, PAIR_CHUNK)
+    count = threads.parts(len(at), jobs, PAIR_CHUNK)
+    tops = np.empty(count, np.int64)
     try:
-        tops = threads.each(jobs, [lambda a=a, b=b: lib.pair_marks(byref(pairs(a, b)), address(mark))
-                                   for a, b in parts])
-        bad = [a - 1 - t for (a, _), t in zip(parts, tops) if t < 0]  # the first pair without its SD
+        with threads.team(jobs if count > 1 else 1) as team:
+            lib.pair_marks_team(team, byref(pairs), count, address(mark), address(tops))
+        bad = [len(at) * k // count - 1 - t for k, t in enumerate(tops.tolist()) if t < 0]  # the first pair without its SD
         if bad:
             raise Rend3rError(f"{_where(int(at[bad[0]]))}: an SE word without its SD")
-        top = max(tops, default=0)
+        top = int(tops.max())
         if top:
             row_of = table.grow(mark, top)
-            lib.pair_apply(byref(pairs(0, len(at))), address(row_of),
-                           native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))
+            lib.pair_apply(byref(pairs), address(row_of), native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))
     finally:  # the marks lie below the largest index written and the table's largest (grow's)
         last = int(table.index[-1]) + 1 if len(table.index) else 0
         mark[:SHAPE_INDEX_LIMIT if top < 0 else max(top, last)] = 0

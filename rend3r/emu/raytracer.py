@@ -223,8 +223,7 @@ def _run(jobs: int, n: int, fn: Callable[..., object], block: object, last: np.n
     team_chunks; a thread takes the next chunk in a microsecond, so many small chunks even
     out uneven ones), each chunk adding to its own copy of the report row ``last``;
     returns the copies stacked."""
-    parts = 1 if jobs <= 1 else max(1, min(CHUNKS_PER_JOB * jobs, n // (smallest or MIN_CHUNK)))
-    outs = _own_lines(last, parts)
+    outs = _own_lines(last, threads.parts(n, jobs, smallest or MIN_CHUNK, CHUNKS_PER_JOB))
     with threads.team(jobs) as team:
         native.library().team_chunks(team, native.function_address(fn), addressof(block), n, len(outs),
                                      address(outs[0]), outs.strides[0])

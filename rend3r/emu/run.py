@@ -10,12 +10,12 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from . import threads
 from .frame import Frame
 from .options import EmuOptions
 from .processor import plan
 from .scene import Scene
 from .stats import FrameStats, RunStats
-from .threads import available_cores
 
 FrameHook = Callable[[Frame], None]
 #: Called at each ``nf`` with the scene about to be rendered and the frame number.
@@ -70,7 +70,7 @@ def frames_at_once(options: EmuOptions, count: int, memory: int = FLIGHT_BYTES) 
     """How many of a run's ``count`` frames render side by side, each on one thread: one per
     thread when the run has a frame for every thread and ``memory`` holds that many frames'
     working arrays; else 1 (each frame then splits over the threads)."""
-    jobs = options.jobs or available_cores()
+    jobs = options.jobs or threads.available_cores()
     at_once = min(jobs, memory // (FRAME_BYTES_PER_PIXEL * options.pixels))
     return at_once if 1 < jobs <= count and at_once > 1 else 1
 
@@ -135,8 +135,9 @@ def run_program(
             oldest()
         pending.append((number, need, pool.submit(render, scene.copy(), one, number)))
 
-    if at_once == 1:
-        planned.replay(on_nf)
+    if at_once == 1:  # the processor's and the frames' passes on one team (the rasterizer runs alone)
+        with threads.team(1 if options.mode == "raster" else options.jobs or threads.available_cores()):
+            planned.replay(on_nf)
     else:
         with ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="rend3r-frame") as pool:
             try:

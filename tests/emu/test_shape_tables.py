@@ -86,11 +86,13 @@ def test_tables_split_over_threads_are_the_same(rows, seed, jobs):
         assert all(a.tobytes() == b.tobytes() for a, b in zip(arrays, arrays2))
 
 
-def test_teams_led_side_by_side_on_busy_helpers():
-    """Two frames set up at once on the two threads of threads.each, each leading a team of
-    two: the pool serves one team at a time and a team never waits for a member, so the
-    other set-up runs on its own thread; both get the same bits as with one job."""
-    from rend3r.emu import bounds, threads
+def test_teams_led_side_by_side():
+    """Two frames set up at once on two threads, each leading a team of two: the pool
+    serves one team at a time and a team never waits for a member, so the other set-up
+    runs on its own thread; both get the same bits as with one job."""
+    import threading
+
+    from rend3r.emu import bounds
 
     rng = np.random.default_rng(7)
     scene = Scene()
@@ -102,9 +104,15 @@ def test_teams_led_side_by_side_on_busy_helpers():
     chunk, bounds.SHAPE_CHUNK = bounds.SHAPE_CHUNK, 8
     try:
         one = set_up(scene, EmuOptions(jobs=1))
-        frames = threads.each(2, [lambda: set_up(scene, EmuOptions(jobs=2))] * 2)
+        frames: list = []
+        runs = [threading.Thread(target=lambda: frames.append(set_up(scene, EmuOptions(jobs=2)))) for _ in range(2)]
+        for run in runs:
+            run.start()
+        for run in runs:
+            run.join()
     finally:
         bounds.SHAPE_CHUNK = chunk
+    assert len(frames) == 2
     for fr in frames:
         assert fr.sf.tobytes() == one.sf.tobytes() and fr.tree.node.tobytes() == one.tree.node.tobytes()
         assert fr.primary[0].box.tobytes() == one.primary[0].box.tobytes()

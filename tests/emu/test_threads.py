@@ -1,10 +1,9 @@
-"""The kernels' threads: the calling thread works beside its helpers; order, progress and
-errors as if the calls ran one after another."""
+"""The kernels' threads (threads.py, csrc/team.c): a team per thread that leads one, the
+splits, and the pool's threads across errors and forks."""
 
 import subprocess
 import sys
 import threading
-import time
 from pathlib import Path
 
 import pytest
@@ -14,56 +13,10 @@ from rend3r.emu import threads
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def test_results_and_progress_come_in_order_on_the_calling_thread():
-    caller, ran, reported = threading.current_thread(), [], []
-
-    def call(k):
-        ran.append(threading.current_thread())
-        time.sleep(0.002 * (k % 3))  # calls end out of order
-        return k * k
-
-    def done(k):
-        assert threading.current_thread() is caller
-        reported.append(k)
-
-    out = threads.each(3, [lambda k=k: call(k) for k in range(12)], done)
-    assert out == [k * k for k in range(12)]
-    assert reported == list(range(12))
-    assert caller in ran  # the caller took calls itself
-    assert len(set(ran)) <= 3
-
-
-def test_an_error_stops_new_calls_and_is_raised_after_the_running_ones():
-    started, finished = [], []
-
-    def call(k):
-        started.append(k)
-        if k == 1:
-            raise ValueError("call 1")
-        time.sleep(0.01)
-        finished.append(k)
-
-    with pytest.raises(ValueError, match="call 1"):
-        threads.each(2, [lambda k=k: call(k) for k in range(50)])
-    assert len(started) < 50  # the calls after the error never started
-    assert sorted(finished) == sorted(k for k in started if k != 1)  # every call started has ended
-
-
-@pytest.mark.parametrize("jobs", [1, 2, 5])
-def test_one_call_or_one_job_runs_here(jobs):
-    here = threading.current_thread()
-    assert threads.each(jobs, [lambda: threading.current_thread()]) == [here]
-    assert threads.each(1, [lambda: threading.current_thread()] * 3) == [here] * 3
-
-
-def test_work_handed_out_from_a_helper_does_not_wait_for_itself():
-    """A call that itself splits work over the threads (its helpers may all be busy,
-    running it): the caller takes every call, and helpers that never started are dropped.
-    In a process of its own, as a helper that waited for itself would hang this one."""
-    code = ("from rend3r.emu import threads\n"
-            "inner = lambda: threads.each(2, [lambda k=k: k for k in range(6)])\n"
-            "assert threads.each(2, [inner, inner]) == [list(range(6))] * 2\n")
-    subprocess.run([sys.executable, "-c", code], check=True, timeout=30)
+@pytest.mark.parametrize(("n", "jobs", "smallest", "per_job", "want"), [
+    (100, 1, 1, 4, 1), (100, 2, 1, 4, 8), (100, 2, 30, 4, 3), (5, 3, 10, 4, 1), (0, 2, 1, 4, 1), (10**6, 2, 10, 32, 64)])
+def test_parts_are_a_few_per_thread_and_never_too_short(n, jobs, smallest, per_job, want):
+    assert threads.parts(n, jobs, smallest, per_job) == want
 
 
 def test_a_team_is_led_once_per_thread_and_ends_with_its_block():

@@ -22,6 +22,7 @@
 #include "kernels.h"
 #include "simd.h"
 #include "cull.h"
+#include "team.h"
 
 /* Whether this processor runs the AVX2 build of the kernels (the _avx2 files of instances/,
  * which also use F16C's float16 conversions). */
@@ -565,6 +566,32 @@ int64_t pair_marks(const Pairs *p, uint8_t *mark)
         }
     }
     return top;
+}
+
+typedef struct {
+    const Pairs *p;
+    int64_t parts;
+    uint8_t *mark;
+    int64_t *tops;
+} PairRanges;
+
+static void pair_range(void *ctx, int64_t k)
+{
+    const PairRanges *r = ctx;
+    int64_t a = r->p->n * k / r->parts, b = r->p->n * (k + 1) / r->parts;
+    Pairs part = *r->p;
+    part.at += a;
+    part.n = b - a;
+    part.tables = part.tables != NULL ? part.tables + a : NULL;
+    r->tops[k] = pair_marks(&part, r->mark);
+}
+
+/* pair_marks over `parts` ranges of the pairs on a team (team.h), range k's result into
+ * tops[k]. */
+void pair_marks_team(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, int64_t *tops)
+{
+    PairRanges r = {p, parts < 1 ? 1 : parts, mark, tops};
+    team_phase(team, pair_range, &r, r.parts);
 }
 
 /* Writes the pairs taken, in order, to a table of 32 property words per row (the last

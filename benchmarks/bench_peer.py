@@ -55,6 +55,7 @@ SPEEDUP = 1.7  # jobs=1 time / jobs=2 time at JOBS_SIZE spheres, at least
 JOBS_SIZE = 4096
 JOBS_ALSO = 65536  # jobs measured here too (no target: how the threads serve a set-up-heavy frame)
 WARM_FRAMES = 3  # untimed frames before each timed one of the jobs measurement
+JOBS_ROUNDS = 15  # alternating rounds of the jobs measurement at least (a frame's speed here drifts within seconds)
 #: (label, numerator, denominator, target): numerators are ours ("fp32 run"), denominators
 #: a Mitsuba variant's median render.
 RATIOS = (("fp32 run / scalar", "fp32", "run", "scalar_rgb", FP32_VS_PEER),
@@ -196,7 +197,7 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
         for precision in ("fp32", "fp16"):
             options = {jobs: EmuOptions(precision=precision, width=WIDTH, height=HEIGHT, jobs=jobs) for jobs in (1, 2)}
             times: dict[int, list[float]] = {1: [], 2: []}
-            for _ in range(runs):
+            for _ in range(max(runs, JOBS_ROUNDS)):
                 for jobs, options_ in options.items():
                     for _ in range(WARM_FRAMES):
                         run_program(wall.words, options_)
@@ -206,7 +207,7 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
             ratio = statistics.median(a / b for a, b in zip(times[1], times[2]))
             target = f"{verdict(ratio, SPEEDUP, False)} (target >= {SPEEDUP:g}x)" if size == JOBS_SIZE \
                 else "(no target)"
-            lines.append(f"jobs, {size:,} spheres, {precision} (unpinned, {len(cpus)} CPUs, {runs} alternating "
+            lines.append(f"jobs, {size:,} spheres, {precision} (unpinned, {len(cpus)} CPUs, {len(times[1])} alternating "
                          f"rounds): jobs=1 run {statistics.median(times[1]):.4f} s, jobs=2 run "
                          f"{statistics.median(times[2]):.4f} s: {ratio:.2f}x faster {target}")
             print(lines[-1], flush=True)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from ctypes import byref
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -83,7 +84,7 @@ class Tree:
         own = np.empty((len(self.items), native.CI_COLUMNS if apex is not None else native.BX_COLUMNS))
         bounds = Bounds(self, np.empty((nodes, native.BV_COLUMNS)), frame, own if axes is not None else None,
                         None if not keys else np.empty((nodes, 3 if axes is not None else native.PK_COLUMNS)))
-        block.kind, block.tree, block.items = kind, bounds.struct(), len(self.items)
+        block.kind, block.tree, block.items = kind, bounds.view, len(self.items)
         block.box, block.own = address(bounds.box), address(own)
         block.node_keys = None if bounds.keys is None else address(bounds.keys)
         block.jobs, block.avx2, block.chunk = jobs, native.isa() == "avx2", shape_bounds.SHAPE_CHUNK
@@ -100,8 +101,9 @@ class Bounds:
     item_box: np.ndarray | None = None  # parallel lines: (items, BX_COLUMNS), each shape's own box
     keys: np.ndarray | None = None  # stop keys (nodes, 3) or a point light's terms (nodes, PK_COLUMNS)
 
-    def struct(self) -> native.Bvh:
-        """The kernels' view (the arrays must outlive it)."""
+    @cached_property
+    def view(self) -> native.Bvh:
+        """The kernels' view (the arrays must outlive it; built once: blocks copy it)."""
         t = self.tree
         return native.Bvh(address(t.node), address(t.items), address(self.box), (*self.frame,), t.nodes,
                           address(t.always), len(t.always),

@@ -180,12 +180,10 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
 }
 _PLAIN = {
     "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
-    "bvh_refit": (None, [POINTER(Bvh), c_void_p, c_int32, c_void_p, c_void_p, c_void_p, c_void_p, c_int64, c_int64]),
     "have_avx2": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
     "stream_scan": (None, [c_void_p, c_int64, c_int64, c_int32, c_int32, c_void_p, c_void_p, c_void_p, c_void_p,
                            c_void_p, c_void_p]),
-    "pair_marks": (c_int64, [POINTER(Pairs), c_void_p]),
     "pair_apply": (None, [POINTER(Pairs), c_void_p, c_void_p]),
     "pair_marks_team": (None, [c_void_p, POINTER(Pairs), c_int64, c_void_p, c_void_p]),
     "mark_rows": (c_int64, [c_void_p, c_int64, c_void_p, c_void_p]),
@@ -196,16 +194,6 @@ _PLAIN = {
     "bundle_bounds": (None, [POINTER(Bundle), c_void_p]),
     "team_chunks": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_int64, c_void_p, c_int64]),
 }
-_PER_ISA = {  # name: (restype, argtypes); each exists once per instruction set (double lanes)
-    "primary_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,
-                              c_void_p, c_void_p, c_void_p]),
-    "shadow_shapes": (None, [c_void_p, c_void_p, c_int64, c_void_p, c_double, c_double, c_double, c_double, c_double,
-                             c_double, c_double, c_void_p, c_double, c_void_p, c_void_p, c_void_p, c_void_p]),
-    "flat_items": (None, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
-    "cone_items": (None, [c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
-}
-
-
 @lru_cache(maxsize=1)
 def library() -> ctypes.CDLL:
     """The kernels' shared library, with every function's argument types declared."""
@@ -221,7 +209,6 @@ def library() -> ctypes.CDLL:
                 table[f"{name}_{suffix}_{isa}"] = sig
     for isa in ("base", "avx2"):
         table[f"round_array_{NARROW}_{isa}"] = (None, [c_void_p, c_void_p, c_int64, POINTER(Format)])
-        table.update({f"{name}_{isa}": sig for name, sig in _PER_ISA.items()})
     for name, (restype, argtypes) in table.items():
         fn = getattr(lib, name, None)
         if fn is not None:  # the AVX2 build exists on x86-64 only
@@ -267,11 +254,6 @@ def kernel(name: str, ar: Arith) -> ctypes._CFuncPtr:
     """The kernel ``name`` compiled for a working precision and subnormal handling (the
     narrow and format kernels are given the format)."""
     return getattr(library(), f"{name}_{suffix(ar)}_{isa()}")
-
-
-def shape_pass(name: str) -> ctypes._CFuncPtr:
-    """The per-shape pass ``name`` (csrc/shape_bounds.inc) for the instruction set in use."""
-    return getattr(library(), f"{name}_{isa()}")
 
 
 def round_narrow(values: np.ndarray, ar: Arith, instruction_set: str | None = None) -> np.ndarray:

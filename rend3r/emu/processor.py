@@ -46,6 +46,7 @@ _F, _C, _L, _SE = (int(o) for o in (Opcode.F, Opcode.C, Opcode.L, Opcode.SE))
 _TABLES = tuple(TS_CODES.values())
 _CODE = {t: i + 1 for i, t in enumerate(_TABLES)}
 _TS_WORDS = np.array([table_select_word(t) for t in _TABLES], dtype=np.uint32)
+_NO_TS, _ENTRY_ONLY = np.empty(0, np.int64), np.zeros(1, np.int64)  # a stream without TS words
 
 
 def _null_mask(table: Table) -> np.ndarray:
@@ -142,11 +143,14 @@ class _Stream:
         nf, lr, self.nr, er = (control[func == int(f)] for f in (Func.NF, Func.LR, Func.NR, Func.ER))
         if prog.options.er_needs_zero:
             er = er[(er + 1 >= n) | (prog.words[np.minimum(er + 1, n - 1)] == 0)]
-        ts = np.isin(words, _TS_WORDS) if prog.options.mode == "hybrid" else np.zeros(len(words), dtype=bool)
-        self.ts_at = control[ts]
-        # The table code after k TS words of the stream (k = 0: 0, the pass's entry table).
-        self.ts_codes = np.append(0, 1 + np.argmax(words[ts][:, None] == _TS_WORDS, axis=1))
-        errors = control[~frame & ~ts]
+        if prog.options.mode == "hybrid":  # TS words select tables; elsewhere they are unknown opcodes
+            ts = np.isin(words, _TS_WORDS)
+            self.ts_at = control[ts]
+            # The table code after k TS words of the stream (k = 0: 0, the pass's entry table).
+            self.ts_codes = np.append(0, 1 + np.argmax(words[ts][:, None] == _TS_WORDS, axis=1))
+            errors = control[~frame & ~ts]
+        else:
+            self.ts_at, self.ts_codes, errors = _NO_TS, _ENTRY_ONLY, control[~frame]
         last = self.by_kind[_PAIR][-1:]
         trailing = last[last == n - 1]  # an SE in the last word
         ends = [(int(a[0]), kind) for a, kind in ((lr, "lr"), (er, "er"), (errors, "error"), (trailing, "error"))

@@ -299,7 +299,7 @@ def _band(fr: _Frame, options: EmuOptions, row0: int, row1: int, rgb: np.ndarray
         extent = (float(parts[:, 1].min()), float(parts[:, 2].max())) if parts[:, 0].sum() else (0.0, 0.0)
         primary = _primary_tree(fr, *extent)
     tree, floor, pc = primary
-    band.pc, band.floor, band.tree = address(pc), address(floor), tree.struct()
+    band.pc, band.floor, band.tree = address(pc), address(floor), tree.view
     for name in ("slot", "sqd", "pt", "nm", "bad", "nan_px", "acc"):
         setattr(band, name, address(a[name]))
     band.index, band.background = address(fr.index), options.background
@@ -361,7 +361,7 @@ def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.
     lp.serial = next(_LIGHT_PASSES)  # its chunks' caches are kept per thread
     if shadows:  # lp points into the arrays of sb: they live until the pass is done
         sb = _shadow_bounds(fr, lp, light, hits, n_pix)
-        lp.tree, lp.radius = sb.bounds.struct(), address(sb.radius)
+        lp.tree, lp.radius = sb.bounds.view, address(sb.radius)
         if point and sb.bounds.keys is not None:  # the terms of its per-node behind test
             lp.point_keys = address(sb.bounds.keys)
         if sb.behind is not None:

@@ -16,9 +16,7 @@ from __future__ import annotations
 
 import os
 import threading
-from contextlib import contextmanager
 from functools import lru_cache
-from typing import Iterator
 
 import numpy as np
 
@@ -43,28 +41,31 @@ def parts(n: int, jobs: int, smallest: int, per_job: int = 4) -> int:
 _LED = threading.local()  # the team this thread leads, while it does
 
 
-@contextmanager
-def team(jobs: int) -> Iterator[int]:
+class team:  # noqa: N801 (used as a function: with threads.team(jobs) as at)
     """A team of threads for compiled calls (csrc/team.h): up to ``jobs - 1`` native
-    threads of the kernels' pool join it while the block runs, and the address yielded is
-    passed to the calls that lead it. They never take the GIL: they join as they wake (the
-    calls never wait for them), wait spinning between the calls, so that a call hands work
-    over in a microsecond, and leave when the block ends. Inside a team this thread leads,
-    the same team is yielded again; while another thread's team is open the pool serves
-    that one, and this one's calls run on this thread alone."""
-    led = getattr(_LED, "team", None)
-    if led is not None:
-        yield led
-        return
-    lib = native.library()
-    state = np.zeros(_team_bytes(), np.uint8)
-    at = _LED.team = native.address(state)
-    lib.team_open(at, jobs - 1)
-    try:
-        yield at
-    finally:
-        _LED.team = None
-        lib.team_close(at)  # returns once no member is inside it: then state may go
+    threads of the kernels' pool join it while the block runs, and the address the block
+    gets is passed to the calls that lead it. They never take the GIL: they join as they
+    wake (the calls never wait for them), wait spinning between the calls, so that a call
+    hands work over in a microsecond, and leave when the block ends. Inside a team this
+    thread leads, the same team is given again; while another thread's team is open the
+    pool serves that one, and this one's calls run on this thread alone."""
+
+    def __init__(self, jobs: int) -> None:
+        self.jobs, self.state = jobs, None
+
+    def __enter__(self) -> int:
+        led = getattr(_LED, "team", None)
+        if led is not None:
+            return led
+        self.state = np.zeros(_team_bytes(), np.uint8)
+        at = _LED.team = native.address(self.state)
+        native.library().team_open(at, self.jobs - 1)
+        return at
+
+    def __exit__(self, *_: object) -> None:
+        if self.state is not None:
+            _LED.team = None
+            native.library().team_close(native.address(self.state))  # returns once no member is inside it
 
 
 @lru_cache(maxsize=1)

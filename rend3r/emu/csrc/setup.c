@@ -1,8 +1,9 @@
 /* A frame's set-up in one compiled call, its passes split over a team of threads
  * (team.h): the shape tables, the shape hierarchy, and each bundle of rays' bounds
- * (rend3r/emu/raytracer.py set_up, bvh.py, bounds.py). Between the passes no Python
- * runs, and passes of a few tens of microseconds split over the cores, which a hand-off
- * through Python (a helper's wake-up, then the GIL) cost as much as it saved.
+ * (rend3r/emu/raytracer.py set_up, bvh.py, bounds.py), and the chunks of the pixel
+ * kernels (raytracer.py _run). Between the passes no Python runs, and passes of a few
+ * tens of microseconds split over the cores, where a hand-off through a Python thread (its
+ * wake-up, then the GIL) cost as much as it saved.
  *
  * Every pass computes each shape, item or node the same way whatever the split, so the
  * bits never depend on the thread count.
@@ -19,7 +20,7 @@
 #define MAX_PARTS 256
 
 /* How many ranges 0..n splits into on jobs threads: a few per thread, so that uneven work
- * evens out, none shorter than smallest unless there is only one (threads.py ranges). */
+ * evens out, none shorter than smallest unless there is only one (threads.py parts). */
 static int64_t parts_of(int64_t n, int32_t jobs, int64_t smallest)
 {
     if (jobs <= 1 || n <= 0)
@@ -136,8 +137,9 @@ static void refit_task(void *ctx, int64_t k)
     refit_range(s->b, s->below[k][0], s->below[k][1]);
 }
 
-/* At least want disjoint subtrees (fewer when the tree has fewer leaves) and the nodes
- * above them, children before parents (bvh.py Tree.subtrees, the same split). Nodes are
+/* At least want disjoint subtrees (fewer when the tree has fewer leaves; the largest
+ * subtree whose root is inner is split at each step) and the nodes above them, children
+ * before parents. Nodes are
  * depth first: node at's left child is at + 1, its right child node[at][0] (inner: count
  * node[at][1] is 0). */
 static void subtrees(const int32_t *node, int64_t nodes, int64_t want, Subtrees *s, int64_t *above, int64_t *n_above)

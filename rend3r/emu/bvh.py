@@ -14,8 +14,7 @@ skipping a node never changes the nearest hit.
 from __future__ import annotations
 
 from ctypes import byref
-from dataclasses import dataclass
-from functools import cached_property
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -100,10 +99,13 @@ class Bounds:
     frame: np.ndarray  # 6 float64
     item_box: np.ndarray | None = None  # parallel lines: (items, BX_COLUMNS), each shape's own box
     keys: np.ndarray | None = None  # stop keys (nodes, 3) or a point light's terms (nodes, PK_COLUMNS)
+    view: native.Bvh = field(init=False, repr=False, compare=False)  # the kernels' view of the arrays above
 
-    @cached_property
-    def view(self) -> native.Bvh:
-        """The kernels' view (the arrays must outlive it; built once: blocks copy it)."""
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "view", self._view())  # built once: the blocks copy it
+
+    def _view(self) -> native.Bvh:
+        """The kernels' view (the arrays must outlive it)."""
         t = self.tree
         return native.Bvh(address(t.node), address(t.items), address(self.box), (*self.frame,), t.nodes,
                           address(t.always), len(t.always),

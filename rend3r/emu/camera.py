@@ -6,7 +6,8 @@ Both return :class:`Rays` in working precision, one ray per pixel in row-major o
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from copy import copy
+from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property, lru_cache
 
@@ -64,7 +65,7 @@ def camera_rays(scene: Scene, options: EmuOptions, arith: Arith) -> Rays:
     frames and runs after (read-only arrays); each call gets its own Rays, so a frame's
     per-pixel ``direction`` goes with it."""
     bits = tuple(scene.camera_bits(n) for n in _RAY_PROPS)
-    return replace(_rays(bits, options.camera, options.width, options.height, arith))
+    return copy(_rays(bits, options.camera, options.width, options.height, arith))
 
 
 @lru_cache(maxsize=8)

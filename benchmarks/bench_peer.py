@@ -207,8 +207,8 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
             ratio = statistics.median(a / b for a, b in zip(times[1], times[2]))
             target = f"{verdict(ratio, SPEEDUP, False)} (target >= {SPEEDUP:g}x)" if size == JOBS_SIZE \
                 else "(no target)"
-            lines.append(f"jobs, {size:,} spheres, {precision} (unpinned, {len(cpus)} CPUs, {len(times[1])} alternating "
-                         f"rounds): jobs=1 run {statistics.median(times[1]):.4f} s, jobs=2 run "
+            lines.append(f"jobs, {size:,} spheres, {precision} (unpinned, {len(cpus)} CPUs, {len(times[1])} "
+                         f"alternating rounds): jobs=1 run {statistics.median(times[1]):.4f} s, jobs=2 run "
                          f"{statistics.median(times[2]):.4f} s: {ratio:.2f}x faster {target}")
             print(lines[-1], flush=True)
     return lines

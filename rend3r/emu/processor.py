@@ -259,7 +259,8 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
     try:
         with threads.team(jobs if count > 1 else 1) as team:
             lib.pair_marks_team(team, byref(pairs), count, address(mark), address(tops))
-        bad = [len(at) * k // count - 1 - t for k, t in enumerate(tops.tolist()) if t < 0]  # the first pair without its SD
+        # the first pair without its SD: range k starts at len(at) * k // count (csrc/kernels.c pair_range)
+        bad = [len(at) * k // count - 1 - t for k, t in enumerate(tops.tolist()) if t < 0]
         if bad:
             raise Rend3rError(f"{_where(int(at[bad[0]]))}: an SE word without its SD")
         top = int(tops.max())

@@ -219,10 +219,10 @@ def _light_rows(lights: list[Light], dtype: np.dtype) -> np.ndarray:
 def _run(jobs: int, n: int, fn: Callable[..., object], block: object, last: np.ndarray,
          smallest: int | None = None) -> np.ndarray:
     """The pixel kernel ``fn(block, k0, k1, out)`` over chunks of 0..n (``smallest`` long at
-    least, MIN_CHUNK if None; at most CHUNKS_PER_JOB a thread) on a team of ``jobs`` threads (csrc/setup.c
-    team_chunks; a thread takes the next chunk in a microsecond, so many small chunks even
-    out uneven ones), each chunk adding to its own copy of the report row ``last``;
-    returns the copies stacked."""
+    least, MIN_CHUNK if None; at most CHUNKS_PER_JOB a thread) on a team of ``jobs``
+    threads (csrc/setup.c team_chunks; a thread takes the next chunk in a microsecond, so
+    many small chunks even out uneven ones), each chunk adding to its own copy of the
+    report row ``last``; returns the copies stacked."""
     outs = _own_lines(last, threads.parts(n, jobs, smallest or MIN_CHUNK, CHUNKS_PER_JOB))
     with threads.team(jobs) as team:
         native.library().team_chunks(team, native.function_address(fn), addressof(block), n, len(outs),

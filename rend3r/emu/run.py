@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections import deque
+from contextlib import nullcontext
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from time import perf_counter
@@ -135,8 +136,8 @@ def run_program(
             oldest()
         pending.append((number, need, pool.submit(render, scene.copy(), one, number)))
 
-    if at_once == 1:  # the processor's and the frames' passes on one team (the rasterizer runs alone)
-        with threads.team(1 if options.mode == "raster" else options.jobs or threads.available_cores()):
+    if at_once == 1:  # the processor's and the frames' passes on one team (the rasterizer uses none)
+        with threads.team(options.jobs or threads.available_cores()) if options.mode != "raster" else nullcontext():
             planned.replay(on_nf)
     else:
         with ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="rend3r-frame") as pool:

@@ -1,10 +1,9 @@
 """The raytracer: nearest hit per pixel, diffuse lighting, shadow rays, NaN accounting.
 
 The frame is rendered in bands of rows, so memory stays bounded at any size, with the
-compiled kernels of ``csrc/datapath.inc`` on ``--jobs`` threads: bands side by side, a
-band per thread when there are few shapes per pixel, else each band's steps split over
-the threads (every pixel is computed the same way whatever the split, so the image does
-not depend on it). Per band:
+compiled kernels of ``csrc/datapath.inc``; every pass splits over a team of ``--jobs``
+threads (:mod:`.threads`; every pixel is computed the same way whatever the split, so the
+image does not depend on it). Per band:
 
 1. the primary directions' shortest and longest length (``directions`` stores a rotated
    camera's directions; a grid camera's come from its axes, once per frame);

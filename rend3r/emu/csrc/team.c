@@ -110,8 +110,9 @@ void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
 }
 
 /* The pool: one team at a time. Its threads sleep on wake until a team is opened for
- * them (the first `wanted` threads join it), count themselves in `inside` while they are
- * members, and team_close waits until `inside` is 0 before the team's memory may go. */
+ * them (the first `wanted` threads join it) and count themselves in the team's `inside`
+ * while they are members; team_close waits until it is 0 before the team's memory may go
+ * (its own members only: another thread's team may open meanwhile). */
 #define POOL_LIMIT 256
 static pthread_mutex_t pool_lock = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t pool_wake = PTHREAD_COND_INITIALIZER;
@@ -120,7 +121,6 @@ static struct {
     int32_t wanted;    /* of them, members of the open team */
     int64_t opened;    /* teams opened so far (a thread joins each at most once) */
     Team *team;        /* the open team, NULL: none */
-    int32_t inside;    /* threads inside the open team */
     int32_t forks;     /* set up pthread_atfork once */
 } pool;
 
@@ -134,11 +134,11 @@ static void *pool_thread(void *arg)
             pthread_cond_wait(&pool_wake, &pool_lock);
         Team *t = pool.team;
         seen = pool.opened;
-        pool.inside++;
+        atomic_fetch_add_explicit(&t->inside, 1, memory_order_relaxed);  /* under the lock: t is open */
         pthread_mutex_unlock(&pool_lock);
         team_member(t);
+        atomic_fetch_sub_explicit(&t->inside, 1, memory_order_release);  /* the last touch of t */
         pthread_mutex_lock(&pool_lock);
-        pool.inside--;
     }
     return NULL;
 }
@@ -148,7 +148,7 @@ static void pool_after_fork(void)
 {
     pthread_mutex_init(&pool_lock, NULL);
     pthread_cond_init(&pool_wake, NULL);
-    pool.started = pool.wanted = pool.inside = 0;
+    pool.started = pool.wanted = 0;
     pool.team = NULL;
 }
 
@@ -197,14 +197,10 @@ void team_close(Team *t)
 {
     atomic_store_explicit(&t->released, TEAM_ENDED, memory_order_release);
     pthread_mutex_lock(&pool_lock);
-    if (pool.team == t) {
-        pool.team = NULL;
-        while (pool.inside > 0) {  /* members see the end within a wait's spin */
-            pthread_mutex_unlock(&pool_lock);
-            sched_yield();
-            pthread_mutex_lock(&pool_lock);
-        }
-    }
+    if (pool.team == t)
+        pool.team = NULL;  /* no thread joins it from now on */
     pthread_mutex_unlock(&pool_lock);
+    while (atomic_load_explicit(&t->inside, memory_order_acquire) > 0)
+        sched_yield();  /* members see the end within a wait's spin */
 }
 #endif

@@ -53,6 +53,7 @@ typedef struct {
     TEAM_ATOMIC(int64_t) released;  /* the phase released last (1, 2, ...; 0: none yet), TEAM_ENDED once ended */
     TEAM_ATOMIC(uint64_t) claim;    /* that phase << 32 | its next task not yet taken */
     int64_t phases;                 /* the leader's count of phases */
+    TEAM_ATOMIC(int32_t) inside;    /* members inside the team (team.c: its memory goes when none is) */
     TeamPhase ring[TEAM_RING];
 } Team;
 

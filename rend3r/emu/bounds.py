@@ -25,10 +25,11 @@ SHAPE_CHUNK = 1 << 10
 
 @dataclass
 class Pass:
-    """A bundle of rays' per-shape pass, run with its refit in one call (bvh.Tree.refit
-    ``shape_pass``): the kernels' block and the arrays it fills."""
+    """A bundle of rays' per-shape pass, run with its refit in one call (bvh.Tree.fit):
+    the kernels' block and the arrays it reads and fills."""
 
     block: native.Bundle
+    table: np.ndarray  # the bound table (n, B_COLUMNS)
     flags: np.ndarray  # bounded per shape, as uint8
     radius: np.ndarray  # cull radius per shape
     floor: np.ndarray | None = None  # primary rays: depth floor per shape
@@ -88,6 +89,8 @@ def _pass(table: np.ndarray, ok: np.ndarray, u: float, tiny: float, overflow: fl
     native.ptr(table, np.float64, (n, native.B_COLUMNS))
     flags = np.ascontiguousarray(ok, np.uint8)
     native.ptr(flags, np.uint8, (n,))
-    p = Pass(native.Bundle(), flags, np.empty(n), **arrays)
-    p.block.ok, p.block.pass_, p.block.u, p.block.tiny, p.block.overflow = address(flags), kind, u, tiny, overflow
+    p = Pass(native.Bundle(), table, flags, np.empty(n), **arrays)
+    b = p.block
+    b.bnd, b.ok, b.n, b.radius, b.pass_ = address(table), address(flags), n, address(p.radius), kind
+    b.u, b.tiny, b.overflow = u, tiny, overflow
     return p

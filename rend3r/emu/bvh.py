@@ -38,37 +38,45 @@ class Tree:
 
     def refit(self, bnd: np.ndarray, radius: np.ndarray, floor: np.ndarray | None = None, *,
               apex: np.ndarray | None = None, axes: np.ndarray | None = None,
-              keys: np.ndarray | None = None, jobs: int = 1, shape_pass: native.Bundle | None = None) -> Bounds:
+              keys: np.ndarray | None = None, jobs: int = 1) -> Bounds:
         """One bundle's node bounds around the balls (centre, ``radius``) of their shapes,
         and their least ``floor`` (None: -inf): the double cones around ``apex`` (lines
         through it) or the boxes on the two unit ``axes`` (2, 3) normal to parallel lines,
         with each shape's own box for parallel lines, and per node the largest of its
         shapes' stop ``keys`` (n, 3; parallel lines) or the joined terms of a point light's
         behind test (``keys`` n x SK_COLUMNS, per node PK_COLUMNS; lines through the apex,
-        ``csrc/kernels.c`` refit_cones). ``shape_pass`` (bounds.py) computes radius, floor
-        and keys first, in the same call. Each shape's own bound is computed first, then
+        ``csrc/kernels.c`` refit_cones). Each shape's own bound is computed first, then
         joined node by node, on a team of ``jobs`` threads (``csrc/setup.c``
-        bundle_bounds: ranges of shapes and items, the nodes' subtrees side by side, then
-        the nodes above them)."""
+        bundle_bounds: ranges of items, the nodes' subtrees side by side, then the nodes
+        above them)."""
         n = len(bnd)
         native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
         radius = np.ascontiguousarray(radius, np.float64)
         native.ptr(radius, np.float64, (n,))
         if floor is not None:
             native.ptr(floor, np.float64, (n,))
-        if (apex is None) == (axes is None):
-            raise ValueError("refit: give the apex of the lines or the axes normal to them")
         if keys is not None:  # parallel lines' stop keys, or a point light's behind terms
             native.ptr(keys, np.float64, (n, 3 if axes is not None else native.SK_COLUMNS))
-        block = shape_pass if shape_pass is not None else native.Bundle()
+        block = native.Bundle()
         block.bnd, block.n, block.radius = address(bnd), n, address(radius)
         block.floor = None if floor is None else address(floor)
         block.keys, block.point = (None, None) if keys is None else \
             (address(keys), None) if axes is not None else (None, address(keys))
-        bounds, own = self.bounds_for(block, apex, axes, self.nodes, keys is not None, jobs)
+        return self._bundle(block, apex, axes, keys is not None, jobs)
+
+    def fit(self, p: shape_bounds.Pass, *, apex: np.ndarray | None = None, axes: np.ndarray | None = None,
+            jobs: int = 1) -> Bounds:
+        """A bundle's per-shape pass ``p`` (bounds.py: its radii, floors and keys), then its
+        node bounds as :meth:`refit` computes them, in one call."""
+        return self._bundle(p.block, apex, axes, p.keys is not None, jobs)
+
+    def _bundle(self, block: native.Bundle, apex: np.ndarray | None, axes: np.ndarray | None, keys: bool,
+                jobs: int) -> Bounds:
+        if (apex is None) == (axes is None):
+            raise ValueError("refit: give the apex of the lines or the axes normal to them")
+        bounds, own = self.bounds_for(block, apex, axes, self.nodes, keys, jobs)  # own: the call's scratch
         with threads.team(jobs) as team:
             native.library().bundle_bounds(byref(block), team)
-        del own  # a cone's own items: scratch, kept until the call returned
         return bounds
 
     def bounds_for(self, block: native.Bundle, apex: np.ndarray | None, axes: np.ndarray | None, nodes: int,

@@ -161,15 +161,13 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
     room = bvh.Tree(np.empty((max(1, 2 * rows), 2), np.int32), np.empty(rows, np.int32), np.empty(rows, np.int32))
     s.node, s.items, s.always = address(room.node), address(room.items), address(room.always)
     s.jobs, s.chunk = jobs, bounds.SHAPE_CHUNK
-    first = scratch = None
+    first = None
     if extent is not None:  # the primary bounds in the same call, around the camera origin
         apex = cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)  # at infinity: nothing is bounded
         first = bounds.primary(bnd, bounded, apex, *extent, ar.unit_roundoff, ar.tiny, ar.overflow)
-        first.block.bnd, first.block.radius = address(bnd), address(first.radius)
-        fitted, scratch = room.bounds_for(first.block, apex, None, room.nodes, False, jobs)
+        fitted, own = room.bounds_for(first.block, apex, None, room.nodes, False, jobs)  # own: the call's scratch
     with threads.team(jobs) as team:
         n = native.library().frame_setup(byref(s), None if first is None else byref(first.block), team)
-    del scratch  # the shapes' own cones: the call's, until it returned
     if n < 0:
         raise Rend3rError(f"not enough memory to build the shape hierarchy of {rows:,} shapes")
     tree = bvh.Tree(room.node[:s.nodes], room.items[:s.counts[0]], room.always[:s.counts[1]])
@@ -340,7 +338,7 @@ def _primary_tree(fr: _Frame, dmin: float, dmax: float) -> _Primary:
     shape its depth floor and cull data."""
     apex = fr.cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)  # at infinity: nothing is bounded
     p = bounds.primary(fr.bnd, fr.bounded, apex, dmin, dmax, fr.ar.unit_roundoff, fr.ar.tiny, fr.ar.overflow)
-    return fr.tree.refit(fr.bnd, p.radius, p.floor, apex=apex, jobs=fr.jobs, shape_pass=p.block), p.floor, p.pc
+    return fr.tree.fit(p, apex=apex, jobs=fr.jobs), p.floor, p.pc
 
 
 def _light(fr: _Frame, options: EmuOptions, k: int, band: native.Band, hits: np.ndarray, n_pix: int,
@@ -411,13 +409,12 @@ def _shadow_bounds(fr: _Frame, lp: native.LightPass, light: np.ndarray, hits: np
             return _unbounded(fr, lp)
         bounded = fr.bounded & bool(np.isfinite(apex).all())
         p = bounds.shadow(fr.bnd, bounded, lo, hi, float(origins[9]), *limits, chord=float(origins[7]))
-        return _ShadowBounds(p.radius, fr.tree.refit(fr.bnd, p.radius, apex=apex, keys=p.keys, jobs=fr.jobs,
-                                                     shape_pass=p.block))
+        return _ShadowBounds(p.radius, fr.tree.fit(p, apex=apex, jobs=fr.jobs))
     length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
     if not 0 < length < np.inf:  # cos is not finite at any point: no shadow ray
         return _unbounded(fr, lp)
     p = bounds.shadow(fr.bnd, fr.bounded, lo, hi, length, *limits, unit=unit, length=length)
-    flat = fr.tree.refit(fr.bnd, p.radius, axes=_normal_plane(unit), keys=p.keys, jobs=fr.jobs, shape_pass=p.block)
+    flat = fr.tree.fit(p, axes=_normal_plane(unit), jobs=fr.jobs)
     return _ShadowBounds(p.radius, flat, p.behind, length, unit)
 
 

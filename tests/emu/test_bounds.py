@@ -61,7 +61,7 @@ def test_every_computed_hit_is_within_the_cull_radius_and_beyond_the_depth_floor
     d64 = np.stack([np.asarray(c, np.float64) for c in d], axis=1)
     length = np.linalg.norm(d64, axis=1)
     p = bounds.primary(table, ok, o64, length.min(), length.max(), ar.unit_roundoff, ar.tiny, ar.overflow)
-    fr.tree.refit(table, p.radius, p.floor, apex=o64, shape_pass=p.block)
+    fr.tree.fit(p, apex=o64)
     radius, floor = p.radius[0], p.floor[0]
     s = shapes.take(0)
     S, D = to_object(ar, s, origin, d)

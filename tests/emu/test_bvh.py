@@ -199,7 +199,7 @@ def test_shape_passes_on_threads_give_the_same_bits(n, seed, jobs):
             runs = []
             for j in (1, jobs):
                 p = make()
-                b = tree.refit(bnd, p.radius, p.floor, keys=p.keys, jobs=j, shape_pass=p.block, **kw)
+                b = tree.fit(p, jobs=j, **kw)
                 box = b.box if "apex" in kw else np.delete(b.box, [4, 5], axis=1)  # a box's columns
                 runs.append([p.radius, p.floor, p.pc, p.behind, p.keys, box, b.keys, b.item_box])
             for one, many in zip(*runs):

@@ -54,7 +54,7 @@ setup(
     ext_modules=[
         Extension(
             "rend3r.emu._kernels",
-            sources=[*(str(CSRC / name) for name in ("kernels.c", "setup.c", "team.c")),
+            sources=[*(str(CSRC / name) for name in ("kernels.c", "setup.c", "band.c", "team.c")),
                      *sorted(str(p) for p in (CSRC / "instances").glob("*.c"))],
             depends=[str(p) for p in sorted(CSRC.glob("*.[hi]*"))],
         )

@@ -15,6 +15,7 @@ from .vec import Vec
 DIRECTIONAL, POINT = LIGHT_SOURCE_CODES["directional"], LIGHT_SOURCE_CODES["point"]
 _SRC_MASK = lookup(Table.LIGHT, "src").value_mask
 WHITE = 0xFFFF
+_PROPS = {n: prop_index(Table.LIGHT, n) for n in ("src", "xloc", "yloc", "zloc", "xfor", "yfor", "zfor", "col", "int")}
 #: Unset (never written since the last nr) colour and intensity: white at full strength.
 DEFAULT_INTENSITY = 1.0
 
@@ -35,8 +36,7 @@ def lights_from_scene(scene: Scene, arith: Arith, model: str = "spec") -> list[L
     ``model="device"``: only light 0, always directional (whatever its ``src``), white at
     intensity 1 (the device ignores colour and intensity).
     """
-    p = {n: prop_index(Table.LIGHT, n) for n in (
-        "src", "xloc", "yloc", "zloc", "xfor", "yfor", "zfor", "col", "int")}
+    p = _PROPS
     out = []
     for index in sorted(scene.lights) if model == "spec" else [0]:
         props = scene.lights.get(index, {})

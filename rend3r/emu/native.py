@@ -130,6 +130,21 @@ class Bundle(Structure):
                 ("own", c_void_p), ("node_keys", c_void_p), ("jobs", c_int32), ("avx2", c_int32), ("chunk", c_int64)]
 
 
+LF_PARALLEL, LF_APEX, LF_FINITE, LF_UNIT, LF_LENGTH, LF_AXES, LF_COLUMNS = 0, 1, 4, 5, 8, 9, 15
+BC_COLUMNS = 6  # render_band's counts (csrc/kernels.h BC_*)
+
+
+class Bands(Structure):
+    """A frame's bands, each rendered in one call (csrc/kernels.h Bands, csrc/band.c render_band)."""
+
+    _fields_ = [("band", POINTER(Band)), ("directions", c_void_p), ("nearest", c_void_p), ("light_pass", c_void_p),
+                ("shadow_origins", c_void_p), ("primary", POINTER(Bundle)), ("light_rows", c_void_p),
+                ("light_row", c_int64), ("lights", c_int64), ("light_frames", c_void_p), ("scales", c_void_p),
+                ("fixed", c_int32), ("item", c_int32), ("bounded", c_void_p), ("items", c_int64),
+                ("overflow", c_double), ("jobs", c_int32), ("avx2", c_int32), ("chunk", c_int64),
+                ("min_chunk", c_int64), ("chunks_per_job", c_int64), ("counts", c_int64 * BC_COLUMNS)]
+
+
 #: Pixels a band may hold and the widest frame, for Band.row_magic (csrc/kernels.h band_row).
 BAND_LIMIT, WIDTH_LIMIT = 1 << 20, 8192
 
@@ -156,11 +171,6 @@ def ptr(a: np.ndarray, dtype: type | np.dtype, shape: tuple[int | None, ...]) ->
     if not ok:
         raise TypeError(f"kernel argument: expected {np.dtype(dtype)} {shape}, got {a.dtype} {a.shape}")
     return address(a)
-
-
-def function_address(fn: ctypes._CFuncPtr) -> int:
-    """The address of a compiled function (for the blocks that call one, e.g. Setup.tables)."""
-    return cast(fn, c_void_p).value
 
 
 #: Kernel suffix per (precision, flush subnormals); narrow formats' kernels are NARROW's (float
@@ -192,7 +202,7 @@ _PLAIN = {
     "team_close": (None, [c_void_p]),
     "frame_setup": (c_int64, [POINTER(Setup), POINTER(Bundle), c_void_p]),
     "bundle_bounds": (None, [POINTER(Bundle), c_void_p]),
-    "team_chunks": (None, [c_void_p, c_void_p, c_void_p, c_int64, c_int64, c_void_p, c_int64]),
+    "render_band": (c_int64, [POINTER(Bands), c_int64, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
 }
 @lru_cache(maxsize=1)
 def library() -> ctypes.CDLL:
@@ -254,6 +264,16 @@ def kernel(name: str, ar: Arith) -> ctypes._CFuncPtr:
     """The kernel ``name`` compiled for a working precision and subnormal handling (the
     narrow and format kernels are given the format)."""
     return getattr(library(), f"{name}_{suffix(ar)}_{isa()}")
+
+
+def kernel_address(name: str, ar: Arith) -> int:
+    """The address of :func:`kernel` (for the blocks that call one, e.g. Setup.tables)."""
+    return _address(f"{name}_{suffix(ar)}_{isa()}")
+
+
+@lru_cache(maxsize=None)
+def _address(symbol: str) -> int:
+    return cast(getattr(library(), symbol), c_void_p).value
 
 
 def round_narrow(values: np.ndarray, ar: Arith, instruction_set: str | None = None) -> np.ndarray:

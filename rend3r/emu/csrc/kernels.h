@@ -209,6 +209,40 @@ typedef struct {            /* one bundle of rays' bounds (setup.c bundle_bounds
     int64_t chunk;          /* shapes or items a range takes at least */
 } Bundle;
 
+/* A pixel kernel of datapath.inc (directions, nearest, light_pass, shadow_origins): its
+ * block, pixels (rows for nearest) a..b, and the report row it adds to. */
+typedef void (*ChunkFn)(const void *block, int64_t a, int64_t b, double *out);
+
+/* Per light, what its shadow rays' bounds need (double; raytracer.py _light_frames): a
+ * directional light (1) or not, a point light's location and whether it is finite, a
+ * directional light's l / |l| and |l|, and two unit axes normal to l. */
+enum { LF_PARALLEL = 0, LF_APEX = 1, LF_FINITE = 4, LF_UNIT = 5, LF_LENGTH = 8, LF_AXES = 9, LF_COLUMNS = 15 };
+
+/* What render_band counts, summed over the bands (raytracer.py _BAND_COUNTS). */
+enum { BC_TESTS = 0, BC_SKIPPED = 1, BC_NAN_TESTS = 2, BC_NAN_RAYS = 3, BC_HITS = 4, BC_SHADOW_RAYS = 5,
+       BC_COLUMNS = 6 };
+
+typedef struct {            /* a frame's bands, each rendered in one call (band.c render_band) */
+    Band *band;             /* the frame's fields (render_band sets a band's rows, arrays and pixels) */
+    ChunkFn directions, nearest, light_pass, shadow_origins; /* the precision's pixel kernels */
+    Bundle *primary;        /* a camera whose directions are measured per pixel: its primary bundle, fitted
+                               to each band's directions (band->tree holds its bounds); else NULL (band->tree
+                               holds the frame's primary bounds) */
+    const char *light_rows; /* lights x LT_COLUMNS, working, light_row bytes a row */
+    int64_t light_row, lights;
+    const double *light_frames; /* lights x LF_COLUMNS */
+    const double *scales;   /* lights x 3: the light colour's channels over their maximum */
+    int32_t fixed;          /* the device's 13-bit intensity converter */
+    int32_t item;           /* bytes of a working value */
+    const uint8_t *bounded; /* per shape */
+    int64_t items;          /* the tree's items */
+    double overflow;        /* the precision's overflow threshold */
+    int32_t jobs, avx2;     /* threads the passes split over; the AVX2 shape passes */
+    int64_t chunk;          /* shapes or items a range takes at least */
+    int64_t min_chunk, chunks_per_job; /* pixels a chunk takes at least; the most chunks a thread takes */
+    int64_t counts[BC_COLUMNS]; /* out: summed over the bands */
+} Bands;
+
 /* The row within its band of pixel p: (p * row_magic) >> 40 equals p / width exactly for
  * p < 2**20 and width <= 8192 (the error p * (row_magic - 2**40/width) / 2**40 < 2**-20
  * stays below the 1/width a fraction p/width keeps from the next integer). */

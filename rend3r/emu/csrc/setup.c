@@ -1,7 +1,7 @@
 /* A frame's set-up in one compiled call, its passes split over a team of threads
  * (team.h): the shape tables, the shape hierarchy, and each bundle of rays' bounds
- * (rend3r/emu/raytracer.py set_up, bvh.py, bounds.py), and the chunks of the pixel
- * kernels (raytracer.py _run). Between the passes no Python runs, and passes of a few
+ * (rend3r/emu/raytracer.py set_up, bvh.py, bounds.py; band.c fits the shadow rays'
+ * bundles). Between the passes no Python runs, and passes of a few
  * tens of microseconds split over the cores, where a hand-off through a Python thread (its
  * wake-up, then the GIL) cost as much as it saved.
  *
@@ -14,52 +14,13 @@
 #include "kernels.h"
 #include "team.h"
 
-/* ---- ranges of work ---- */
+/* Ranges a pass over shapes or items takes per thread. */
+#define SHAPE_PARTS_PER_JOB 4
 
-/* The most ranges a pass splits into. */
-#define MAX_PARTS 256
-
-/* How many ranges 0..n splits into on jobs threads: a few per thread, so that uneven work
- * evens out, none shorter than smallest unless there is only one (threads.py parts). */
-static int64_t parts_of(int64_t n, int32_t jobs, int64_t smallest)
+static int64_t shape_parts(int64_t n, int32_t jobs, int64_t smallest)
 {
-    if (jobs <= 1 || n <= 0)
-        return 1;
-    int64_t parts = n / (smallest > 0 ? smallest : 1), most = 4 * (int64_t)jobs;
-    parts = MIN(parts, MIN(most, MAX_PARTS));
-    return parts < 1 ? 1 : parts;
-}
-
-static inline int64_t edge(int64_t n, int64_t parts, int64_t k)
-{
-    return n * k / parts;
-}
-
-/* ---- a pixel kernel's chunks (raytracer.py _run) ---- */
-
-/* A pixel kernel of datapath.inc (directions, nearest, light_pass, shadow_origins): its
- * block, pixels a..b, and the report row it adds to. */
-typedef void (*ChunkFn)(const void *block, int64_t a, int64_t b, void *out);
-
-typedef struct {
-    ChunkFn fn;
-    const void *block;
-    int64_t n, parts, stride;
-    char *outs;
-} Chunks;
-
-static void chunk_task(void *ctx, int64_t k)
-{
-    const Chunks *c = ctx;
-    c->fn(c->block, edge(c->n, c->parts, k), edge(c->n, c->parts, k + 1), c->outs + c->stride * k);
-}
-
-/* fn over 0..n in parts chunks on the team, chunk k reporting into the row at outs + k
- * stride bytes (each its own cache lines: raytracer.py _own_lines). */
-void team_chunks(Team *team, ChunkFn fn, const void *block, int64_t n, int64_t parts, void *outs, int64_t stride)
-{
-    Chunks c = {fn, block, n, parts < 1 ? 1 : parts, stride, outs};
-    team_phase(team, chunk_task, &c, c.parts);
+    int64_t parts = parts_of(n, jobs, smallest, SHAPE_PARTS_PER_JOB);
+    return parts < MAX_PARTS ? parts : MAX_PARTS;
 }
 
 /* ---- per-shape passes (kernels.c, shape_bounds.inc) ---- */
@@ -101,7 +62,7 @@ static void shape_range(const Bundle *b, int64_t a, int64_t e)
 static void shape_task(void *ctx, int64_t k)
 {
     const Bundle *b = ctx;
-    int64_t parts = parts_of(b->n, b->jobs, b->chunk);
+    int64_t parts = shape_parts(b->n, b->jobs, b->chunk);
     shape_range(b, edge(b->n, parts, k), edge(b->n, parts, k + 1));
 }
 
@@ -109,7 +70,7 @@ static void shape_task(void *ctx, int64_t k)
 static void item_task(void *ctx, int64_t k)
 {
     const Bundle *b = ctx;
-    int64_t n = b->items, parts = parts_of(n, b->jobs, b->chunk), a = edge(n, parts, k), e = edge(n, parts, k + 1);
+    int64_t n = b->items, parts = shape_parts(n, b->jobs, b->chunk), a = edge(n, parts, k), e = edge(n, parts, k + 1);
     const int32_t *items = b->tree.items + a;
     if (b->kind == BVH_CONE)
         PICK(b, cone_items)(items, e - a, b->bnd, b->radius, b->tree.frame, b->own + CI_COLUMNS * a);
@@ -181,7 +142,7 @@ static void subtrees(const int32_t *node, int64_t nodes, int64_t want, Subtrees 
 /* The bundle's items and refit, after its radii are known. */
 static void bundle_tree(Bundle *b, Team *team)
 {
-    int64_t parts = parts_of(b->items, b->jobs, b->chunk);
+    int64_t parts = shape_parts(b->items, b->jobs, b->chunk);
     team_phase(team, item_task, b, parts);
     Subtrees s = {.b = b};
     int64_t above[MAX_PARTS], n_above;
@@ -196,7 +157,7 @@ static void bundle_tree(Bundle *b, Team *team)
 void bundle_bounds(Bundle *b, Team *team)
 {
     if (b->pass != PASS_NONE)
-        team_phase(team, shape_task, b, parts_of(b->n, b->jobs, b->chunk));
+        team_phase(team, shape_task, b, shape_parts(b->n, b->jobs, b->chunk));
     bundle_tree(b, team);
 }
 
@@ -237,7 +198,7 @@ static void build_task(void *ctx, int64_t k)
  * the build could not allocate its working copies. */
 int64_t frame_setup(Setup *s, Bundle *primary, Team *team)
 {
-    Tables t = {.s = s, .primary = primary, .parts = parts_of(s->rows, s->jobs, s->chunk)};
+    Tables t = {.s = s, .primary = primary, .parts = shape_parts(s->rows, s->jobs, s->chunk)};
     team_phase(team, tables_task, &t, t.parts);
     int64_t n = 0;
     for (int64_t k = 0; k < t.parts; k++) {
@@ -254,8 +215,8 @@ int64_t frame_setup(Setup *s, Bundle *primary, Team *team)
     s->shapes = n;
     if (primary != NULL)
         primary->n = n;
-    int64_t shape_parts = primary != NULL ? parts_of(n, primary->jobs, primary->chunk) : 0;
-    team_phase(team, build_task, &t, 1 + shape_parts);
+    int64_t passes = primary != NULL ? shape_parts(n, primary->jobs, primary->chunk) : 0;
+    team_phase(team, build_task, &t, 1 + passes);
     if (s->nodes < 0)
         return -1;
     if (primary != NULL) {

@@ -61,4 +61,26 @@ typedef struct {
  * finished (team.c). */
 void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks);
 
+/* ---- ranges of work (threads.py parts) ---- */
+
+/* The most ranges a pass over shapes splits into. */
+#define MAX_PARTS 256
+
+/* How many ranges 0..n splits into on jobs threads: up to per_job a thread, so that uneven
+ * work evens out, none shorter than smallest unless there is only one. */
+static inline int64_t parts_of(int64_t n, int32_t jobs, int64_t smallest, int64_t per_job)
+{
+    if (jobs <= 1 || n <= 0)
+        return 1;
+    int64_t parts = n / (smallest > 0 ? smallest : 1), most = per_job * (int64_t)jobs;
+    parts = parts < most ? parts : most;
+    return parts < 1 ? 1 : parts;
+}
+
+/* Range k of 0..n split into parts: edge(k) .. edge(k + 1). */
+static inline int64_t edge(int64_t n, int64_t parts, int64_t k)
+{
+    return n * k / parts;
+}
+
 #endif

@@ -93,7 +93,8 @@ class Pairs(Structure):
     """SE/SD pairs for pair_marks and pair_apply (csrc/kernels.c Pairs)."""
 
     _fields_ = [("words", c_void_p), ("n_words", c_int64), ("at", c_void_p), ("n", c_int64), ("fields", c_void_p),
-                ("tables", c_void_p), ("entry", c_int32), ("wanted", c_void_p), ("null", c_void_p)]
+                ("tables", c_void_p), ("entry", c_int32), ("wanted", c_void_p), ("null", c_void_p),
+                ("records", c_void_p)]
 
 
 class LightPass(Structure):

@@ -217,6 +217,11 @@ class _Stream:
 #: (lo, width) of the fields the pair kernels read, in their order (csrc/kernels.c Pairs).
 _PAIR_FIELDS = np.array([(f.lo, f.width) for f in (SE_INDEX_HI, SE_INDEX_LO, PROP, SE_PROP2, SD_DATA, SD_DATA2)],
                         np.int64)
+#: What a decoded pair's record holds (csrc/kernels.c pair_record): the index in 20 bits,
+#: properties in 5, data in 16.
+if SE_INDEX_HI.width + SE_INDEX_LO.width > 20 or max(PROP.width, SE_PROP2.width) > 5 or \
+        max(SD_DATA.width, SD_DATA2.width) > 16:
+    raise ImportError("the SE/SD fields outgrow csrc/kernels.c pair_record")
 #: Per table code, 1 where pairs go to (scene.objects, scene.triangles): in hybrid mode
 #: those aimed at the triangle table go to ``triangles``, else all go to ``objects``.
 _TRIANGLE_CODE = (np.arange(len(_TABLES) + 1) == _CODE[Table.TRIANGLE]).astype(np.uint8)
@@ -251,8 +256,10 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
     them all)."""
     if not wanted.any():
         return
+    records = np.empty(len(at), np.uint64)  # each pair decoded once, by pair_marks for pair_apply
     pairs = native.Pairs(address(words), len(words), address(at), len(at), address(_PAIR_FIELDS),
-                         None if tables is None else address(tables), entry, address(wanted), address(_SE_NULL))
+                         None if tables is None else address(tables), entry, address(wanted), address(_SE_NULL),
+                         address(records))
     lib, mark, top = native.library(), _marks(), -1
     count = threads.parts(len(at), jobs, PAIR_CHUNK)
     tops = np.empty(count, np.int64)

@@ -14,7 +14,8 @@ mask is compared with our fp64 frame (a check that both render the same scene).
 
 Targets (reported, not asserted): fp32 at most 0.5x the time of Mitsuba scalar_rgb and of
 llvm_ad_rgb, fp16 at most 1x scalar_rgb's, at every size; 16x more spheres (4,096 to 65,536)
-at most 3x the time; jobs=2 at least 1.7x faster than jobs=1 at 4,096 spheres (unpinned).
+at most 3x the time (pinned, the two sizes alternating round by round); jobs=2 at least
+1.7x faster than jobs=1 at 4,096 spheres (unpinned, alternating likewise).
 Exit status 0, except 1 when an fp32 frame is not faithful to fp64 (a bug).
 
     python benchmarks/bench_peer.py [--sizes 1 16 256 4096 65536] [--runs 5]
@@ -167,16 +168,33 @@ def measure(n: int, runs: int, variants: list[str]) -> Row:
     return row
 
 
-def scaling(rows: dict[int, Row]) -> list[str]:
-    """Lines on the cost of 16x more spheres (4,096 to 65,536), if both were measured."""
-    if 4096 not in rows or 65536 not in rows:
+def scaling(sizes: list[int], runs: int) -> list[str]:
+    """Lines on the cost of 16x more spheres (4,096 to 65,536), on the pinned thread,
+    printing as it goes: the two sizes alternate round by round (each warmed with one
+    frame, then timed), so that a drift of the machine's speed falls on both, and the
+    ratio is the median of the rounds' ratios (the table's figures, minutes apart, moved
+    by a third between a quiet and a slow spell)."""
+    if 4096 not in sizes or 65536 not in sizes:
         return ["scaling 4,096 -> 65,536 spheres: not measured (needs --sizes 4096 65536)"]
+    programs = {n: walls.wall(n, lights=1).words for n in (4096, 65536)}
     lines = []
     for precision in ("fp32", "fp16"):
-        a, b = rows[4096].ours[precision], rows[65536].ours[precision]
-        lines.append(f"scaling 4,096 -> 65,536 spheres, {precision}: run {b.run / a.run:.2f}x "
-                     f"{verdict(b.run / a.run, SCALING)}, render {b.render / a.render:.2f}x "
-                     f"{verdict(b.render / a.render, SCALING)} (target <= {SCALING:g}x)")
+        options = EmuOptions(precision=precision, width=WIDTH, height=HEIGHT, jobs=1)
+        run: dict[int, list[float]] = {4096: [], 65536: []}
+        render: dict[int, list[float]] = {4096: [], 65536: []}
+        for _ in range(max(runs, JOBS_ROUNDS)):
+            for n, words in programs.items():
+                run_program(words, options)
+                start = time.perf_counter()
+                result = run_program(words, options)
+                run[n].append(time.perf_counter() - start)
+                render[n].append(result.stats.frames[0].seconds)
+        ratios = [statistics.median(b / a for a, b in zip(t[4096], t[65536])) for t in (run, render)]
+        lines.append(f"scaling 4,096 -> 65,536 spheres, {precision} ({len(run[4096])} alternating rounds, pinned): "
+                     f"run {ratios[0]:.2f}x {verdict(ratios[0], SCALING)}, render {ratios[1]:.2f}x "
+                     f"{verdict(ratios[1], SCALING)} (target <= {SCALING:g}x; medians {statistics.median(run[4096]):.4f} "
+                     f"and {statistics.median(run[65536]):.4f} s run)")
+        print(lines[-1], flush=True)
     return lines
 
 
@@ -339,8 +357,7 @@ def main() -> int:
     rows = {n: measure(n, args.runs, active) for n in sorted(args.sizes)}
     variants = [v for v in variants if any(v in r.peer for r in rows.values())]
     print()
-    notes = scaling(rows)
-    print("\n".join(notes))
+    notes = scaling(sorted(args.sizes), args.runs)
     os.sched_setaffinity(0, cpus)  # unpinned: the jobs=2 threads start after this and inherit it
     notes += jobs_scaling(args.runs, cpus)
     if args.markdown:

@@ -6,11 +6,13 @@ the working-precision raycaster computes it* (not merely in exact arithmetic); d
 |q|^2 max|s_i| <= 2^6, finite centre) are bounded (the shape tables mark them, see
 ``csrc/datapath.inc`` shape_tables); every other shape gets an infinite cull radius and a
 zero depth floor, so every ray tests it.
+
+The frame's set-up runs :func:`primary` (csrc/setup.c); a band's shadow bundles are filled
+in C from its hit points (csrc/band.c shadow_bounds).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,44 +49,18 @@ def primary(table: np.ndarray, ok: np.ndarray, apex: np.ndarray, dmin: float, dm
     (``csrc/kernels.h`` PC_COLUMNS); ``u``, ``tiny`` and ``overflow`` are the precision's
     unit roundoff, smallest normal and overflow threshold."""
     n = len(table)
-    p = _pass(table, ok, u, tiny, overflow, native.PASS_PRIMARY, floor=np.empty(n), pc=np.empty((n, native.PC_COLUMNS)))
+    p = shape_pass(table, ok, u, tiny, overflow, native.PASS_PRIMARY, floor=np.empty(n),
+                   pc=np.empty((n, native.PC_COLUMNS)))
     p.block.apex[:] = [float(c) for c in apex]
     p.block.dmin, p.block.dmax = dmin, dmax
     p.block.floor, p.block.pc = address(p.floor), address(p.pc)
     return p
 
 
-def shadow(table: np.ndarray, ok: np.ndarray, lo: np.ndarray, hi: np.ndarray, dmin: float, u: float, tiny: float,
-           overflow: float, *, chord: float = np.nan, unit: np.ndarray | None = None, length: float = 0.0) -> Pass:
-    """Per shape, the cull radius of shadow rays from origins in the box ``lo``..``hi``
-    with directions at least ``dmin`` long, widened by the origins' rounding and, for a
-    point light, by ``chord`` (the largest turn of a rounded l off the line to the light);
-    for a directional light along the unit vector ``unit`` (|l| = ``length``), also the
-    behind terms and stop keys (n, 3 each) of the light pass's per-packet test
-    (``csrc/kernels.h`` LightPass.behind, ``csrc/shape_bounds.inc`` shadow_shapes); for a
-    point light (``chord`` given) the terms of its per-node behind test (n, SK_COLUMNS:
-    ``csrc/cull.h`` point_behind4) as keys."""
-    n = len(table)
-    lo3, hi3 = [float(c) for c in lo], [float(c) for c in hi]  # 3-vectors: plain arithmetic
-    p = _pass(table, ok, u, tiny, overflow, native.PASS_SHADOW)
-    b = p.block
-    b.mid[:] = [(a + c) / 2 for a, c in zip(lo3, hi3)]
-    b.half = math.sqrt(sum((c - a) * (c - a) for a, c in zip(lo3, hi3))) / 2
-    b.magnitude = max(abs(c) for c in lo3 + hi3)  # of any origin's coordinates
-    b.dmin, b.chord, b.l_len = dmin, chord, length
-    if unit is not None:
-        p.unit = np.ascontiguousarray(unit, np.float64)
-        b.unit = native.ptr(p.unit, np.float64, (3,))
-        p.behind, p.keys = np.empty((n, 3)), np.empty((n, 3))
-        b.behind, b.keys = address(p.behind), address(p.keys)
-    elif chord == chord:
-        p.keys = np.empty((n, native.SK_COLUMNS))
-        b.point = address(p.keys)
-    return p
-
-
-def _pass(table: np.ndarray, ok: np.ndarray, u: float, tiny: float, overflow: float, kind: int, **arrays) -> Pass:
-    """A pass's block over the checked table and uint8 flags, with its radius array."""
+def shape_pass(table: np.ndarray, ok: np.ndarray, u: float, tiny: float, overflow: float, kind: int,
+               **arrays: np.ndarray) -> Pass:
+    """A pass of ``kind`` (native.PASS_*): its block over the checked table and uint8 flags,
+    with its radius array (``arrays``: the Pass's others)."""
     n = len(table)
     native.ptr(table, np.float64, (n, native.B_COLUMNS))
     flags = np.ascontiguousarray(ok, np.uint8)

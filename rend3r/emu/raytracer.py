@@ -245,11 +245,12 @@ def _bands(fr: _Frame, options: EmuOptions) -> tuple[native.Bands, list]:
     tree, floor, pc = primary
     band.pc, band.floor, band.tree = address(pc), address(floor), tree.view
     band.index, band.background = address(fr.index), options.background
-    keep += [primary, _light_frames(fr.light_rows), _scales(fr.lights)]
+    frames, scales = _light_frames(fr.light_rows), _scales(fr.lights)
+    keep += [primary, frames, scales]
     for name in ("directions", "nearest", "light_pass", "shadow_origins"):
         setattr(b, name, native.kernel_address(name, fr.ar))
     b.light_rows, b.light_row, b.lights = address(fr.light_rows), fr.light_rows.strides[0], len(fr.lights)
-    b.light_frames, b.scales = address(keep[-2]), address(keep[-1])
+    b.light_frames, b.scales = address(frames), address(scales)
     b.fixed, b.item, b.bounded, b.items = int(options.intensity_fixed), fr.dtype.itemsize, address(fr.bounded), \
         len(fr.tree.items)
     b.overflow, b.jobs, b.avx2, b.chunk = fr.ar.overflow, fr.jobs, native.isa() == "avx2", bounds.SHAPE_CHUNK

@@ -175,7 +175,7 @@ static int64_t next_serial(void)
 }
 #endif
 
-/* A light's shadow rays' bounds over the band (bounds.py shadow, bvh.py): from the box of
+/* A light's shadow rays' bounds over the band (shape_bounds.inc shadow_shapes, bvh.h): from the box of
  * the band's hit points (hits, the nearest-hit pass's report) and, for a point light,
  * what shadow_origins finds of the points' l; a directional light's also get the behind
  * terms and stop keys, so a packet skips whole subtrees behind its origins. Where nothing
@@ -278,9 +278,9 @@ static void light(Bands *f, Team *team, Work *w, int64_t k, const double *hits, 
 
 /* ---- the band ---- */
 
-/* Rows row0..row1 of the frame f rendered into rgb, depth and prov (the band's pixels),
- * adding the band's counts to f->counts. Returns 0, or -1 when its working memory could
- * not be allocated (nothing is then drawn). */
+/* Rows row0..row1 of the frame f (at most 2**20 pixels: band_row) rendered into rgb,
+ * depth and prov (the band's pixels), adding the band's counts to f->counts. Returns 0,
+ * or -1 when its working memory could not be allocated (nothing is then drawn). */
 int64_t render_band(Bands *f, int64_t row0, int64_t row1, uint16_t *rgb, float *depth, int32_t *prov, Team *team)
 {
     Band *b = f->band;
@@ -316,5 +316,9 @@ int64_t render_band(Bands *f, int64_t row0, int64_t row1, uint16_t *rgb, float *
     f->counts[BC_HITS] += (int64_t)done[OUT_SHOWN];
     f->counts[BC_NAN_RAYS] += (int64_t)done[OUT_NAN_RAYS];
     free(memory);
+    b->slot = NULL;  /* the band's arrays are gone */
+    b->sqd = b->pt = b->nm = b->dirs = NULL;
+    b->bad = b->nan_px = NULL;
+    b->acc = NULL;
     return 0;
 }

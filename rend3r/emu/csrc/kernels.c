@@ -575,7 +575,7 @@ static inline unsigned pair_stores(const uint8_t *wanted, const uint8_t *null, c
  * pair into its record (pair_record). Returns the largest
  * index marked + 1 (0 for none), or -1 - k for the first pair k whose SD lies outside the
  * words (then nothing may be written). */
-int64_t pair_marks(const Pairs *p, uint8_t *mark)
+static inline __attribute__((always_inline)) int64_t marks(const Pairs *p, uint8_t *mark, int one_table)
 {
     const uint32_t *words = p->words;
     const int64_t *at = p->at;
@@ -584,11 +584,16 @@ int64_t pair_marks(const Pairs *p, uint8_t *mark)
     int32_t entry = p->entry, table;
     PairFields f = pair_fields(p);
     uint64_t *records = p->records;
+    uint8_t nulls[32];  /* one table: its null row and whether it is taken, read once (the byte stores may alias) */
+    int take = one_table && wanted[entry];
+    if (one_table)
+        memcpy(nulls, null + 32 * (entry - 1), sizeof nulls);
     for (int64_t k = 0; k < n; k++) {
         if (at[k] < 0 || at[k] + 1 >= n_words)
             return -1 - k;
         uint32_t se = words[at[k]], sd = words[at[k] + 1];
-        unsigned stores = pair_stores(wanted, null, tables, entry, &f, k, se, &table);
+        unsigned stores = !one_table ? pair_stores(wanted, null, tables, entry, &f, k, se, &table)
+                          : take ? (unsigned)!nulls[FIELD(f, se, 2)] | (unsigned)!nulls[FIELD(f, se, 3)] << 1 : 0u;
         int64_t index = ((int64_t)FIELD(f, se, 0) << f.hi_shift) | FIELD(f, se, 1);
         records[k] = pair_record(stores, FIELD(f, se, 2), FIELD(f, se, 3), index, FIELD(f, sd, 4), FIELD(f, sd, 5));
         if (!stores)
@@ -600,6 +605,11 @@ int64_t pair_marks(const Pairs *p, uint8_t *mark)
         }
     }
     return top;
+}
+
+int64_t pair_marks(const Pairs *p, uint8_t *mark)
+{
+    return p->tables == NULL ? marks(p, mark, 1) : marks(p, mark, 0);  /* NULL: no TS word, one table */
 }
 
 typedef struct {

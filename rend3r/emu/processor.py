@@ -249,11 +249,11 @@ PAIR_CHUNK = 1 << 12
 def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, entry: int, wanted: np.ndarray,
                  table: ObjectTable, jobs: int) -> None:
     """Apply the SE/SD pairs at ``at`` (each writes prop then prop2; a write to a null
-    property stores nothing) that ``wanted`` takes to ``table``, in compiled passes over
-    their words (csrc/kernels.c): the indices written (in ranges of pairs on a team of
-    ``jobs`` threads when there are many), then the writes, in order (threads that each
-    took a range of rows spent nearly as long reading every pair as one thread writing
-    them all)."""
+    property stores nothing) that ``wanted`` takes to ``table``, in compiled passes
+    (csrc/kernels.c): over their words, the indices written and each pair decoded (in
+    ranges of pairs on a team of ``jobs`` threads when there are many), then over the
+    decoded pairs the writes, in order (threads that each took a range of rows spent
+    nearly as long reading every pair as one thread writing them all)."""
     if not wanted.any():
         return
     records = np.empty(len(at), np.uint64)  # each pair decoded once, by pair_marks for pair_apply

@@ -13,9 +13,10 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
+from ..isa import Table
 from .arith import Arith
 from .options import EmuOptions
-from .scene import Scene
+from .scene import Scene, prop_index
 from .vec import Quat, Vec, rotate
 
 #: The device's ray generator: start values and the step added once per pixel (float16 bits).
@@ -64,8 +65,14 @@ def camera_rays(scene: Scene, options: EmuOptions, arith: Arith) -> Rays:
     camera gives the same rays, so the last few cameras' axes and terms are kept for the
     frames and runs after (read-only arrays); each call gets its own Rays, so a frame's
     per-pixel ``direction`` goes with it."""
-    bits = tuple(scene.camera_bits(n) for n in _RAY_PROPS)
+    bits = tuple(scene.camera.get(i, 0) for i in _ray_props())
     return copy(_rays(bits, options.camera, options.width, options.height, arith))
+
+
+@lru_cache(maxsize=1)
+def _ray_props() -> tuple[int, ...]:
+    """The camera table's indices of _RAY_PROPS."""
+    return tuple(prop_index(Table.CAMERA, n) for n in _RAY_PROPS)
 
 
 @lru_cache(maxsize=8)

@@ -16,6 +16,7 @@ DIRECTIONAL, POINT = LIGHT_SOURCE_CODES["directional"], LIGHT_SOURCE_CODES["poin
 _SRC_MASK = lookup(Table.LIGHT, "src").value_mask
 WHITE = 0xFFFF
 _PROPS = {n: prop_index(Table.LIGHT, n) for n in ("src", "xloc", "yloc", "zloc", "xfor", "yfor", "zfor", "col", "int")}
+_VALUES = ("xloc", "yloc", "zloc", "xfor", "yfor", "zfor", "int")  # the float16 ones
 #: Unset (never written since the last nr) colour and intensity: white at full strength.
 DEFAULT_INTENSITY = 1.0
 
@@ -45,10 +46,10 @@ def lights_from_scene(scene: Scene, arith: Arith, model: str = "spec") -> list[L
             continue
         if model != "spec":
             props = {k: v for k, v in props.items() if k not in (p["col"], p["int"])}
-        v = lambda n: arith.from_bits(props.get(p[n], 0))  # noqa: E731
+        v = arith.from_bits([props.get(p[n], 0) for n in _VALUES])  # one conversion: 0-d views of it
         out.append(Light(
-            index, kind, (v("xloc"), v("yloc"), v("zloc")), (v("xfor"), v("yfor"), v("zfor")),
+            index, kind, (v[0, ...], v[1, ...], v[2, ...]), (v[3, ...], v[4, ...], v[5, ...]),
             props.get(p["col"], WHITE),
-            v("int") if p["int"] in props else arith.const(DEFAULT_INTENSITY),
+            v[6, ...] if p["int"] in props else arith.const(DEFAULT_INTENSITY),
         ))
     return out

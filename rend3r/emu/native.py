@@ -131,7 +131,7 @@ class Bundle(Structure):
                 ("own", c_void_p), ("node_keys", c_void_p), ("jobs", c_int32), ("avx2", c_int32), ("chunk", c_int64)]
 
 
-LF_PARALLEL, LF_APEX, LF_FINITE, LF_UNIT, LF_LENGTH, LF_AXES, LF_COLUMNS = 0, 1, 4, 5, 8, 9, 15
+LF_PARALLEL, LF_APEX, LF_UNIT, LF_LENGTH, LF_AXES, LF_COLUMNS = 0, 1, 4, 7, 8, 14
 BC_COLUMNS = 6  # render_band's counts (csrc/kernels.h BC_*)
 
 

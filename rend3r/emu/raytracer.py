@@ -283,14 +283,13 @@ def _extent(cam: np.ndarray, xs: np.ndarray, ys: np.ndarray, rotated: bool) -> t
 
 def _light_frames(rows: np.ndarray) -> np.ndarray:
     """Per light, what its shadow rays' bounds need (lights, LF_COLUMNS; csrc/kernels.h
-    LF_*): whether it is directional, a point light's location and whether it is finite, a
-    directional light's l / |l|, |l| and two unit axes normal to l."""
+    LF_*): whether it is directional, a point light's location, a directional light's
+    l / |l|, |l| and two unit axes normal to l."""
     out = np.zeros((len(rows), native.LF_COLUMNS))
     for row, light in zip(out, rows.tolist()):  # Python floats: numpy takes microseconds a call on 3-vectors
-        apex = light[native.LT_LOC:native.LT_LOC + 3]
         length, unit = _unit(light[native.LT_DIR:native.LT_DIR + 3])
         axes = _normal_plane(unit) if 0 < length < math.inf else (0.0,) * 6
-        row[:] = (light[native.LT_KIND] != native.LIGHT_POINT, *apex, all(map(math.isfinite, apex)), *unit, length,
+        row[:] = (light[native.LT_KIND] != native.LIGHT_POINT, *light[native.LT_LOC:native.LT_LOC + 3], *unit, length,
                   *axes)
     return out
 

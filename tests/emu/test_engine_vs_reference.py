@@ -23,6 +23,7 @@ from rend3r.emu import bounds, raytracer, reference
 from rend3r.emu.raytracer import render_frame
 from rend3r.emu.reference import render_reference
 from rend3r.emu.scene import Scene
+from rend3r.emu.stats import FrameStats
 from rend3r.isa import CameraSet, FrameOp, Func, LightSet, ShapeSet, Table, ValueType, encode, lookup
 from rend3r.isa.float16 import float_to_bits
 
@@ -145,9 +146,14 @@ def assert_same(a: Frame, b: Frame) -> None:
 
 
 def check(words: list[int], options: EmuOptions) -> None:
-    scene = scene_of(words, options)
+    hits = compare(scene_of(words, options), options).hits
+    event(f"pixels hit: {'none' if not hits else 'some' if hits < options.pixels // 4 else 'many'}")
+
+
+def compare(scene: Scene, options: EmuOptions) -> FrameStats:
+    """The engine's frame against the oracle's, then split over threads and bands; returns
+    the engine's stats."""
     engine, stats = render_frame(scene, options)
-    event(f"pixels hit: {'none' if not stats.hits else 'some' if stats.hits < options.pixels // 4 else 'many'}")
     assert_same(engine, render_reference(scene, options))
     chunks = raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK, raytracer.BAND_PIXELS
     # tiny chunks: every pass split over the team; bands of 5 rows (the last one shorter)
@@ -160,6 +166,7 @@ def check(words: list[int], options: EmuOptions) -> None:
             assert (counts.hits, counts.shadow_rays) == (stats.hits, stats.shadow_rays)
     finally:
         raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK, raytracer.BAND_PIXELS = chunks
+    return stats
 
 
 scene_args = (camera, st.lists(light, max_size=3), st.lists(shape, min_size=1, max_size=7),
@@ -318,3 +325,23 @@ def test_point_light_among_columns(g, k, fill, distance, at, stretch, rot, prec)
     cam, shapes = _columns(g, k, fill, distance, stretch, rot, 0.12)
     options = EmuOptions(precision=prec[0], subnormals=prec[1], width=32, height=24)
     _check_counting_blocked(program(cam, [light], shapes, [], options), options)
+
+
+def test_lights_whose_shadow_rays_nothing_bounds():
+    """A point light at infinity or NaN (no l is usable, so csrc/band.c shadow_bounds gives
+    its rays infinite radii) and a directional light of no direction (likewise): the band
+    goes through with hit points whose lighting is NaN and no shadow ray (their cosines
+    are not finite), and the frames equal the oracle's."""
+    from .scenes import Prog
+
+    inf, nan = float("inf"), float("nan")
+    for light in ({"src": 2, "xloc": inf, "yloc": 1.0, "zloc": 0.0}, {"src": 2, "xloc": nan},
+                  {"src": 2, "zloc": -inf}, {"src": 1, "xfor": 0.0, "yfor": 0.0, "zfor": 0.0}):
+        prog = Prog().nr().cam(hfov=0.6, vfov=0.6).light(0, col=0xFFFF, int=1.0, **light)
+        for i, (x, z) in enumerate(((0.0, -3.5), (0.8, -5.0), (-0.9, -4.2))):
+            prog.sphere(i, loc=(x, 0.1 * i, z), scale=(0.4, 0.4, 0.4))
+        words = prog.nf().words
+        for precision in ("fp16", "fp32"):
+            options = EmuOptions(precision=precision, width=48, height=36)
+            stats = compare(scene_of(words, options), options)
+            assert stats.hits + stats.nan_rays > 0 and stats.shadow_rays == 0

@@ -99,7 +99,6 @@ typedef struct {
     double *rows;           /* report rows, capacity of them */
     int64_t capacity;
     double *radius, *behind, *keys, *point, *box, *own, *node_keys; /* a light's shadow bounds */
-    uint8_t *none;          /* zeros: no shape bounded */
 } Work;
 
 /* Lays out size bytes at *at, aligned to a cache line; returns where they start. */
@@ -137,7 +136,6 @@ static size_t lay_out(Bands *f, Work *w, char *base, int64_t npix)
     w->box = carve(base, &at, sizeof(double) * (size_t)(BV_COLUMNS * nodes));
     w->own = carve(base, &at, sizeof(double) * (size_t)(MAX((int)CI_COLUMNS, (int)BX_COLUMNS) * items));
     w->node_keys = carve(base, &at, sizeof(double) * (size_t)(MAX(3, (int)PK_COLUMNS) * nodes));
-    w->none = carve(base, &at, (size_t)n);
     return at;
 }
 
@@ -195,12 +193,9 @@ static void shadow_bounds(const Bands *f, Team *team, Work *w, LightPass *lp, co
     if (bounded && !lp->parallel) {  /* a point light: the rounding of l turns each ray off the line to it */
         double o[10];
         run(f, team, w, f->shadow_origins, lp, b->npix, f->min_chunk, ORIGINS, 10, merge_origins, o);
-        bounded = o[8] != 0;
+        bounded = o[8] != 0;  /* none when the light is not finite: then no l is */
         bd.kind = BVH_CONE;
         memcpy(bd.tree.frame, lf + LF_APEX, 3 * sizeof(double));
-        if (lf[LF_FINITE] == 0)  /* a light at infinity: nothing is bounded */
-            memset(w->none, 0, (size_t)bd.n);
-        bd.ok = lf[LF_FINITE] != 0 ? f->bounded : w->none;
         bd.dmin = o[9];
         bd.chord = o[7];
         if (bd.chord == bd.chord)  /* the terms of its per-node behind test */

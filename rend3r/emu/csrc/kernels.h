@@ -214,9 +214,9 @@ typedef struct {            /* one bundle of rays' bounds (setup.c bundle_bounds
 typedef void (*ChunkFn)(const void *block, int64_t a, int64_t b, double *out);
 
 /* Per light, what its shadow rays' bounds need (double; raytracer.py _light_frames): a
- * directional light (1) or not, a point light's location and whether it is finite, a
- * directional light's l / |l| and |l|, and two unit axes normal to l. */
-enum { LF_PARALLEL = 0, LF_APEX = 1, LF_FINITE = 4, LF_UNIT = 5, LF_LENGTH = 8, LF_AXES = 9, LF_COLUMNS = 15 };
+ * directional light (1) or not, a point light's location, a directional light's l / |l|
+ * and |l|, and two unit axes normal to l. */
+enum { LF_PARALLEL = 0, LF_APEX = 1, LF_UNIT = 4, LF_LENGTH = 7, LF_AXES = 8, LF_COLUMNS = 14 };
 
 /* What render_band counts, summed over the bands (raytracer.py _BAND_COUNTS). */
 enum { BC_TESTS = 0, BC_SKIPPED = 1, BC_NAN_TESTS = 2, BC_NAN_RAYS = 3, BC_HITS = 4, BC_SHADOW_RAYS = 5,

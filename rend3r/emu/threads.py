@@ -31,11 +31,11 @@ def available_cores() -> int:
         return os.cpu_count() or 1
 
 
-def parts(n: int, jobs: int, smallest: int, per_job: int = 4) -> int:
-    """How many ranges 0..n splits into on ``jobs`` threads: up to ``per_job`` a thread (so
-    that uneven work evens out), none shorter than ``smallest`` unless there is only one
-    (range k is n * k // parts .. n * (k + 1) // parts, csrc/setup.c edge)."""
-    return 1 if jobs <= 1 else max(1, min(per_job * jobs, n // smallest))
+def parts(n: int, jobs: int, smallest: int) -> int:
+    """How many ranges 0..n splits into on ``jobs`` threads: up to four a thread (so that
+    uneven work evens out), none shorter than ``smallest`` unless there is only one (range
+    k is n * k // parts .. n * (k + 1) // parts: csrc/team.h parts_of and edge)."""
+    return 1 if jobs <= 1 else max(1, min(4 * jobs, n // smallest))
 
 
 _LED = threading.local()  # the team this thread leads, while it does

@@ -13,11 +13,10 @@ from rend3r.emu import threads
 ROOT = Path(__file__).resolve().parents[2]
 
 
-@pytest.mark.parametrize(("n", "jobs", "smallest", "per_job", "want"), [
-    (100, 1, 1, 4, 1), (100, 2, 1, 4, 8), (100, 2, 30, 4, 3), (5, 3, 10, 4, 1), (0, 2, 1, 4, 1),
-    (10**6, 2, 10, 32, 64)])
-def test_parts_are_a_few_per_thread_and_never_too_short(n, jobs, smallest, per_job, want):
-    assert threads.parts(n, jobs, smallest, per_job) == want
+@pytest.mark.parametrize(("n", "jobs", "smallest", "want"), [
+    (100, 1, 1, 1), (100, 2, 1, 8), (100, 2, 30, 3), (5, 3, 10, 1), (0, 2, 1, 1), (10**6, 3, 10, 12)])
+def test_parts_are_a_few_per_thread_and_never_too_short(n, jobs, smallest, want):
+    assert threads.parts(n, jobs, smallest) == want
 
 
 def test_a_team_is_led_once_per_thread_and_ends_with_its_block():

@@ -622,7 +622,7 @@ typedef struct {
 static void pair_range(void *ctx, int64_t k)
 {
     const PairRanges *r = ctx;
-    int64_t a = r->p->n * k / r->parts, b = r->p->n * (k + 1) / r->parts;
+    int64_t a = edge(r->p->n, r->parts, k), b = edge(r->p->n, r->parts, k + 1);
     Pairs part = *r->p;
     part.at += a;
     part.n = b - a;

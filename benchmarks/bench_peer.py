@@ -15,7 +15,9 @@ mask is compared with our fp64 frame (a check that both render the same scene).
 Targets (reported, not asserted): fp32 at most 0.5x the time of Mitsuba scalar_rgb and of
 llvm_ad_rgb, fp16 at most 1x scalar_rgb's, at every size; 16x more spheres (4,096 to 65,536)
 at most 3x the time (pinned, the two sizes alternating round by round); jobs=2 at least
-1.7x faster than jobs=1 at 4,096 spheres (unpinned, alternating likewise).
+1.7x faster than jobs=1 at 4,096 spheres (unpinned, alternating likewise; each round also
+measures what two pinned single-thread processes get from the two CPUs in those seconds,
+two_cpus.py, the most a jobs=2 frame could gain then).
 Exit status 0, except 1 when an fp32 frame is not faithful to fp64 (a bug).
 
     python benchmarks/bench_peer.py [--sizes 1 16 256 4096 65536] [--runs 5]
@@ -40,6 +42,7 @@ import numpy as np
 import walls
 from bench_raytrace import calibration_us
 from peer_mitsuba import VARIANTS, render_spheres
+from two_cpus import TwoCpus
 
 from rend3r.emu import native
 from rend3r.emu.options import EmuOptions
@@ -204,7 +207,9 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
     speed falls on both; in a round each renders WARM_FRAMES frames untimed (its threads
     and caches warm, as in a run of frames: on this VM the first two jobs=2 frames after
     jobs=1 frames run 20-30% slow while the idle second vCPU wakes) and one timed. The
-    ratio is the median of the rounds' ratios."""
+    ratio is the median of the rounds' ratios. Each round then measures the two CPUs'
+    ceiling (two_cpus.py); the share of it reached is the median of the rounds' ratio over
+    their ceiling."""
     if len(cpus) < 2:
         line = f"jobs=2 vs jobs=1: not measured (this process may use {len(cpus)} CPU)"
         print(line)
@@ -215,19 +220,26 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
         for precision in ("fp32", "fp16"):
             options = {jobs: EmuOptions(precision=precision, width=WIDTH, height=HEIGHT, jobs=jobs) for jobs in (1, 2)}
             times: dict[int, list[float]] = {1: [], 2: []}
-            for _ in range(max(runs, JOBS_ROUNDS)):
-                for jobs, options_ in options.items():
-                    for _ in range(WARM_FRAMES):
+            ceilings = []
+            with TwoCpus(cpus, size, precision, WIDTH, HEIGHT) as two:
+                for _ in range(max(runs, JOBS_ROUNDS)):
+                    for jobs, options_ in options.items():
+                        for _ in range(WARM_FRAMES):
+                            run_program(wall.words, options_)
+                        start = time.perf_counter()
                         run_program(wall.words, options_)
-                    start = time.perf_counter()
-                    run_program(wall.words, options_)
-                    times[jobs].append(time.perf_counter() - start)
-            ratio = statistics.median(a / b for a, b in zip(times[1], times[2]))
+                        times[jobs].append(time.perf_counter() - start)
+                    ceilings.append(two.ceiling())
+            ratios = [a / b for a, b in zip(times[1], times[2])]
+            ratio = statistics.median(ratios)
+            share = statistics.median(r / c for r, c in zip(ratios, ceilings))
             target = f"{verdict(ratio, SPEEDUP, False)} (target >= {SPEEDUP:g}x)" if size == JOBS_SIZE \
                 else "(no target)"
             lines.append(f"jobs, {size:,} spheres, {precision} (unpinned, {len(cpus)} CPUs, {len(times[1])} "
                          f"alternating rounds): jobs=1 run {statistics.median(times[1]):.4f} s, jobs=2 run "
-                         f"{statistics.median(times[2]):.4f} s: {ratio:.2f}x faster {target}")
+                         f"{statistics.median(times[2]):.4f} s: {ratio:.2f}x faster {target}; two pinned "
+                         f"processes in the same rounds render {statistics.median(ceilings):.2f}x the frames of one "
+                         f"(two_cpus.py), jobs=2 reaches {share:.0%} of that")
             print(lines[-1], flush=True)
     return lines
 

@@ -1,0 +1,113 @@
+"""What two CPUs of this machine give a frame right now: two processes, each pinned to one
+CPU and rendering the same frame with jobs=1, timed alone and side by side.
+
+The ceiling of a round is 2 x (mean time alone) / (mean time side by side): the frames two
+cores finish in the time one core finishes one. A ``--jobs 2`` frame can be at most that
+much faster than a ``--jobs 1`` frame in the same seconds (it splits one frame over the
+same two cores, and also shares its decoding). On a VM whose host is busy, two busy vCPUs
+each run slower than one busy vCPU alone, and the ceiling falls well below 2.
+bench_peer.py measures it in the rounds of its jobs measurement, so that a missed speedup
+can be told apart from a machine that had no second core to give.
+
+    python benchmarks/two_cpus.py [--size 4096] [--precision fp32] [--rounds 10]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+WARM_FRAMES = 3  # untimed frames before each timed one, as bench_peer.py's jobs rounds
+
+
+def _worker(cpu: int, size: int, precision: str, width: int, height: int) -> None:
+    """Renders on request: each line read (a count of untimed frames) is answered with
+    the seconds of one more frame."""
+    os.sched_setaffinity(0, {cpu})
+    import walls
+
+    from rend3r.emu.options import EmuOptions
+    from rend3r.emu.run import run_program
+    from rend3r.memory import reuse_freed_memory
+
+    reuse_freed_memory()
+    wall, options = walls.wall(size, lights=1), EmuOptions(precision=precision, width=width, height=height, jobs=1)
+    run_program(wall.words, options)
+    print("ready", flush=True)
+    for line in sys.stdin:
+        for _ in range(int(line)):
+            run_program(wall.words, options)
+        start = time.perf_counter()
+        run_program(wall.words, options)
+        print(time.perf_counter() - start, flush=True)
+
+
+class TwoCpus:
+    """Two worker processes pinned to the first two of ``cpus``, rendering the wall of
+    ``size`` spheres in ``precision``; a context manager (the workers end on exit)."""
+
+    def __init__(self, cpus: set[int], size: int, precision: str, width: int, height: int) -> None:
+        self.workers = [subprocess.Popen([sys.executable, str(Path(__file__).resolve()), "--worker", str(cpu),
+                                          "--size", str(size), "--precision", precision, "--width", str(width),
+                                          "--height", str(height)],
+                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+                        for cpu in sorted(cpus)[:2]]
+        for w in self.workers:
+            if w.stdout.readline().strip() != "ready":
+                self.close()
+                raise RuntimeError("a two_cpus.py worker did not start")
+
+    def _frames(self, which: list[int]) -> list[float]:
+        for i in which:
+            self.workers[i].stdin.write(f"{WARM_FRAMES}\n")
+            self.workers[i].stdin.flush()
+        return [float(self.workers[i].stdout.readline()) for i in which]
+
+    def ceiling(self) -> float:
+        """One round: each worker alone, then both at once; 2 x mean alone / mean together."""
+        alone = self._frames([0]) + self._frames([1])
+        together = self._frames([0, 1])
+        return 2 * statistics.mean(alone) / statistics.mean(together)
+
+    def close(self) -> None:
+        for w in self.workers:
+            w.stdin.close()
+            w.wait()
+
+    def __enter__(self) -> TwoCpus:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--size", type=int, default=4096)
+    ap.add_argument("--precision", default="fp32", choices=("fp16", "fp32", "fp64"))
+    ap.add_argument("--rounds", type=int, default=10)
+    ap.add_argument("--width", type=int, default=512)
+    ap.add_argument("--height", type=int, default=384)
+    ap.add_argument("--worker", type=int, help=argparse.SUPPRESS)  # the CPU of a worker process
+    args = ap.parse_args()
+    if args.worker is not None:
+        _worker(args.worker, args.size, args.precision, args.width, args.height)
+        return 0
+    cpus = os.sched_getaffinity(0)
+    if len(cpus) < 2:
+        print(f"not measured: this process may use {len(cpus)} CPU")
+        return 0
+    with TwoCpus(cpus, args.size, args.precision, args.width, args.height) as two:
+        rounds = [two.ceiling() for _ in range(args.rounds)]
+    print(f"{args.size:,} spheres, {args.precision}: two pinned processes render {statistics.median(rounds):.2f}x "
+          f"the frames of one (median of {args.rounds} rounds; {min(rounds):.2f}-{max(rounds):.2f})")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -10,7 +10,9 @@ warm-up: "run" is the whole call (decoding the program included, ~655k words at 
 spheres), "render" the frame's render time. fp16 and fp32 frames are checked against fp64's
 with walls.fp16_faithful (they may differ at silhouettes only). Mitsuba, per variant: its
 scene build (objects and BVH) and the median of its timed renders, printed apart; its hit
-mask is compared with our fp64 frame (a check that both render the same scene).
+mask is compared with our fp64 frame (a check that both render the same scene). Each ratio
+is the median over --runs rounds, each one timed run of ours (the precision the ratio
+names) right before one timed Mitsuba render, so that the machine's drift falls on both.
 
 Targets (reported, not asserted): fp32 at most 0.5x the time of Mitsuba scalar_rgb and of
 llvm_ad_rgb, fp16 at most 1x scalar_rgb's, at every size; 16x more spheres (4,096 to 65,536)
@@ -105,12 +107,13 @@ class Row:
     n: int  #: spheres
     ours: dict[str, Ours] = field(default_factory=dict)
     peer: dict[str, Peer] = field(default_factory=dict)
+    #: (precision, kind, variant): the median of our time over the variant's render time,
+    #: the two alternating render by render (measure)
+    paired: dict[tuple[str, str, str], float] = field(default_factory=dict)
 
     def ratio(self, precision: str, kind: str, variant: str) -> float | None:
         """Our ``kind`` time ("run" or "render") over the variant's render time, if measured."""
-        if variant not in self.peer:
-            return None
-        return getattr(self.ours[precision], kind) / self.peer[variant].render
+        return self.paired.get((precision, kind, variant))
 
 
 def time_ours(words: np.ndarray, precision: str, runs: int, jobs: int) -> tuple[float, float, RunResult]:
@@ -151,14 +154,28 @@ def measure(n: int, runs: int, variants: list[str]) -> Row:
         print(f"  ours {precision:11} run {run:8.4f} s  render {render:8.4f} s  tests {st.tests:>11,}  "
               f"hits {st.hits:>7,}  nan {st.nan_tests:>9,}{check}", flush=True)
     for variant in list(variants):
+        compared = sorted({precision for _, precision, _, v, _ in RATIOS if v == variant})
+        options = {precision: EmuOptions(precision=precision, width=WIDTH, height=HEIGHT, jobs=1)
+                   for precision in compared}
+        ours: dict[tuple[str, str], list[float]] = {(p, kind): [] for p in compared for kind in ("run", "render")}
+
+        def between() -> None:  # before each of Mitsuba's timed renders: ours, timed
+            for precision, options_ in options.items():
+                start = time.perf_counter()
+                result = run_program(wall.words, options_)
+                ours[precision, "run"].append(time.perf_counter() - start)
+                ours[precision, "render"].append(result.stats.frames[0].seconds)
+
         try:
             r = render_spheres(variant, wall.centers, wall.radii, wall.colors, wall.light, width=WIDTH,
-                               height=HEIGHT, hfov=wall.fov, vfov=wall.fov, runs=runs, threads=1)
+                               height=HEIGHT, hfov=wall.fov, vfov=wall.fov, runs=runs, threads=1, between=between)
         except RuntimeError as e:
             print(f"  mitsuba {variant} FAILED, skipped from here on: {e}", flush=True)
             variants.remove(variant)
             continue
         p = row.peer[variant] = Peer(r.build_seconds, r.median, float(np.mean(r.hit != (ref >= 0))))
+        for (precision, kind), times in ours.items():
+            row.paired[precision, kind, variant] = statistics.median(a / b for a, b in zip(times, r.render_seconds))
         print(f"  mitsuba {variant:11} build {p.build:8.4f} s  render {p.render:8.4f} s  "
               f"hit mask vs our fp64: {100 * p.disagree:.3f}% of pixels differ", flush=True)
     cells = []
@@ -167,7 +184,7 @@ def measure(n: int, runs: int, variants: list[str]) -> Row:
         if value is not None:
             cells.append(f"{label} {value:.3f} {verdict(value, limit)} (<= {limit:g})")
     if cells:
-        print("  ratios: " + "; ".join(cells), flush=True)
+        print("  ratios (medians of paired renders, ours and Mitsuba's alternating): " + "; ".join(cells), flush=True)
     return row
 
 
@@ -364,7 +381,8 @@ def main() -> int:
         variants = []
     print("ours 'run' = the whole run_program call, decoding the program included; 'render' = the frame's render "
           "time.\nMitsuba 'render' = median of mi.render + copy to numpy, EXCLUDING its scene build (objects + BVH), "
-          "printed apart as 'build'.\nratios = our time / Mitsuba's render time (lower is faster).")
+          "printed apart as 'build'.\nratios = our time / Mitsuba's render time (lower is faster), each the median "
+          "over rounds of one our run then one Mitsuba render.")
     active = list(variants)  # measure() drops a variant that fails
     rows = {n: measure(n, args.runs, active) for n in sorted(args.sizes)}
     variants = [v for v in variants if any(v in r.peer for r in rows.values())]

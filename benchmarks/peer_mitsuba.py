@@ -37,7 +37,7 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -83,8 +83,13 @@ def find_libllvm() -> str | None:
 
 def render_spheres(variant: str, centers: np.ndarray, radii: np.ndarray, colors: np.ndarray,
                    light_dir: tuple[float, float, float], width: int = 512, height: int = 384,
-                   hfov: float = 1.0, vfov: float = 1.0, runs: int = 3, threads: int = 1) -> PeerResult:
+                   hfov: float = 1.0, vfov: float = 1.0, runs: int = 3, threads: int = 1,
+                   between: Callable[[], None] | None = None) -> PeerResult:
     """Build and render the spheres with Mitsuba ``variant`` in a subprocess pinned to ``threads`` CPUs.
+
+    ``between`` (if given) runs in this process before each timed render, while the
+    subprocess waits: a benchmark times its own renderer there, so that the two alternate
+    render by render and a drift of the machine's speed falls on both.
 
     ``centers`` (N, 3) and ``radii`` (N,) in world units, ``colors`` (N, 3) linear diffuse
     reflectance in [0, 1]; ``light_dir`` is the direction the light travels. Mitsuba's
@@ -120,15 +125,36 @@ def render_spheres(variant: str, centers: np.ndarray, radii: np.ndarray, colors:
         # Pin first: threads inherit the affinity of the thread that creates them.
         code = ("import os, sys; os.sched_setaffinity(0, {int(c) for c in sys.argv[1].split(',')})\n"
                 "sys.path.insert(0, sys.argv[2]); from peer_mitsuba import _worker; _worker(sys.argv[3], sys.argv[4])")
-        proc = subprocess.run([sys.executable, "-c", code, ",".join(map(str, cpus[:threads])),
-                               os.path.dirname(os.path.abspath(__file__)), str(scene), str(out)],
-                              env=env, capture_output=True, text=True)
-        if proc.returncode != 0:
-            raise RuntimeError(f"Mitsuba peer ({variant}) failed: {proc.stderr.strip()[-2000:]}")
+        with open(Path(tmp, "stderr.txt"), "w+") as err:
+            proc = subprocess.Popen([sys.executable, "-c", code, ",".join(map(str, cpus[:threads])),
+                                     os.path.dirname(os.path.abspath(__file__)), str(scene), str(out)],
+                                    env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=err, text=True)
+            with proc:
+                for _ in range(runs):  # the worker waits for a line before each timed render
+                    if not _said(proc, "ready"):
+                        break
+                    if between is not None:
+                        between()
+                    proc.stdin.write("go\n")
+                    proc.stdin.flush()
+                proc.stdin.close()
+                proc.stdout.read()
+            err.seek(0)
+            if proc.returncode != 0:
+                raise RuntimeError(f"Mitsuba peer ({variant}) failed: {err.read().strip()[-2000:]}")
         with np.load(out) as r:
             kernel = float(r["kernel"]) if r["kernel"] >= 0 else None
             return PeerResult(variant, n, threads, float(r["build"]), float(r["warmup"]), r["render"].tolist(),
                               kernel, r["image"], r["hit"])
+
+
+def _said(proc: subprocess.Popen, word: str) -> bool:
+    """Reads the worker's output up to a line ``word`` (Mitsuba may print other lines);
+    False when it ended first."""
+    for line in proc.stdout:
+        if line.strip() == word:
+            return True
+    return False
 
 
 def _build_scene(mi: Any, s: dict[str, np.ndarray]) -> Any:
@@ -193,6 +219,9 @@ def _worker(scene_path: str, out_path: str) -> None:
     warmup = time.perf_counter() - start
     renders = []
     for _ in range(runs):
+        print("ready", flush=True)
+        if not sys.stdin.readline():  # render_spheres runs its `between` meanwhile
+            sys.exit("the benchmark stopped before the timed renders")
         start = time.perf_counter()
         image = np.array(mi.render(scene, spp=1), dtype=np.float32)
         renders.append(time.perf_counter() - start)

@@ -21,7 +21,7 @@ from array import array
 from ctypes import byref
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Callable, Sequence
+from typing import Callable, NamedTuple, Sequence
 
 import numpy as np
 
@@ -78,8 +78,7 @@ def _where(pc: int) -> str:
     return f"address {pc} (0x{pc:04x})"
 
 
-@dataclass(frozen=True)
-class _Writes:
+class _Writes(NamedTuple):
     """Writes of one kind in program order: the writing instruction's address, the light
     or object index (0 for the camera), the property and the bits."""
 

@@ -15,7 +15,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..isa import Table, lookup
-from ..isa.tables import LIGHT_INDEX_LIMIT, PROP_LIMIT, SHAPE_INDEX_LIMIT
+from ..isa.tables import PROP_LIMIT, SHAPE_INDEX_LIMIT
 
 
 @lru_cache(maxsize=256)
@@ -25,15 +25,6 @@ def prop_index(table: Table, name: str) -> int:
     if prop is None:
         raise KeyError(f"{table.value} table has no property {name!r}")
     return prop.index
-
-
-def _last(cell: np.ndarray, cells: int) -> np.ndarray:
-    """For writes to ``cell`` (each in ``range(cells)``) in program order: True for the
-    last write to each cell."""
-    position = np.arange(len(cell), dtype=np.int32 if len(cell) < 2**31 else np.int64)
-    last = np.full(cells, -1, dtype=position.dtype)
-    np.maximum.at(last, cell, position)
-    return last[cell] == position
 
 
 class ObjectTable:
@@ -109,16 +100,17 @@ class Scene:
         self.triangles.clear()
 
     def write_camera(self, prop: np.ndarray, data: np.ndarray) -> None:
-        """C writes in program order, null properties dropped (the last write wins)."""
-        last = _last(prop, PROP_LIMIT)
-        self.camera.update(zip(prop[last].tolist(), data[last].tolist()))
+        """C writes in program order, null properties dropped (the last write wins: a
+        dict's update keeps the last value of a key)."""
+        self.camera.update(zip(prop.tolist(), data.tolist()))
 
     def write_lights(self, index: np.ndarray, prop: np.ndarray, data: np.ndarray) -> None:
-        """L writes in program order, null properties dropped (the last write wins); the
-        loop runs once per distinct (light, property), not per word."""
-        last = _last(index.astype(np.int64) * PROP_LIMIT + prop, LIGHT_INDEX_LIMIT * PROP_LIMIT)
-        for light, p, bits in zip(index[last].tolist(), prop[last].tolist(), data[last].tolist()):
-            self.lights.setdefault(light, {})[p] = bits
+        """L writes in program order, null properties dropped (the last write wins); a dict
+        keeps each (light, property)'s last value, so the loop runs once per distinct
+        one, not per word."""
+        last = dict(zip((index.astype(np.int64) * PROP_LIMIT + prop).tolist(), data.tolist()))
+        for cell, bits in last.items():
+            self.lights.setdefault(cell // PROP_LIMIT, {})[cell % PROP_LIMIT] = bits
 
     def camera_bits(self, name: str, default: int = 0) -> int:
         return self.camera.get(prop_index(Table.CAMERA, name), default)

@@ -12,7 +12,8 @@ with walls.fp16_faithful (they may differ at silhouettes only). Mitsuba, per var
 scene build (objects and BVH) and the median of its timed renders, printed apart; its hit
 mask is compared with our fp64 frame (a check that both render the same scene). Each ratio
 is the median over --runs rounds, each one timed run of ours (the precision the ratio
-names) right before one timed Mitsuba render, so that the machine's drift falls on both.
+names, after WARM_FRAMES untimed) right before one timed Mitsuba render (after one
+untimed), so that the machine's drift falls on both and each finds the caches warm.
 
 Targets (reported, not asserted): fp32 at most 0.5x the time of Mitsuba scalar_rgb and of
 llvm_ad_rgb, fp16 at most 1x scalar_rgb's, at every size; 16x more spheres (4,096 to 65,536)
@@ -60,7 +61,7 @@ SCALING = 3.0  # time(65,536 spheres) / time(4,096 spheres), at most
 SPEEDUP = 1.7  # jobs=1 time / jobs=2 time at JOBS_SIZE spheres, at least
 JOBS_SIZE = 4096
 JOBS_ALSO = 65536  # jobs measured here too (no target: how the threads serve a set-up-heavy frame)
-WARM_FRAMES = 3  # untimed frames before each timed one of the jobs measurement
+WARM_FRAMES = 3  # untimed frames before each timed one of the paired measurements (peer, jobs)
 JOBS_ROUNDS = 15  # alternating rounds of the jobs measurement at least (a frame's speed here drifts within seconds)
 #: (label, numerator, denominator, target): numerators are ours ("fp32 run"), denominators
 #: a Mitsuba variant's median render.
@@ -159,8 +160,10 @@ def measure(n: int, runs: int, variants: list[str]) -> Row:
                    for precision in compared}
         ours: dict[tuple[str, str], list[float]] = {(p, kind): [] for p in compared for kind in ("run", "render")}
 
-        def between() -> None:  # before each of Mitsuba's timed renders: ours, timed
+        def between() -> None:  # before each of Mitsuba's timed renders (and its untimed one): ours
             for precision, options_ in options.items():
+                for _ in range(WARM_FRAMES):
+                    run_program(wall.words, options_)
                 start = time.perf_counter()
                 result = run_program(wall.words, options_)
                 ours[precision, "run"].append(time.perf_counter() - start)
@@ -382,7 +385,7 @@ def main() -> int:
     print("ours 'run' = the whole run_program call, decoding the program included; 'render' = the frame's render "
           "time.\nMitsuba 'render' = median of mi.render + copy to numpy, EXCLUDING its scene build (objects + BVH), "
           "printed apart as 'build'.\nratios = our time / Mitsuba's render time (lower is faster), each the median "
-          "over rounds of one our run then one Mitsuba render.")
+          "over rounds of one our run then one Mitsuba render, each after untimed ones.")
     active = list(variants)  # measure() drops a variant that fails
     rows = {n: measure(n, args.runs, active) for n in sorted(args.sizes)}
     variants = [v for v in variants if any(v in r.peer for r in rows.values())]

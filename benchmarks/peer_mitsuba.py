@@ -89,7 +89,9 @@ def render_spheres(variant: str, centers: np.ndarray, radii: np.ndarray, colors:
 
     ``between`` (if given) runs in this process before each timed render, while the
     subprocess waits: a benchmark times its own renderer there, so that the two alternate
-    render by render and a drift of the machine's speed falls on both.
+    render by render and a drift of the machine's speed falls on both. Each timed render
+    then follows an untimed one, so that it finds the core's caches warm with its own data
+    as ``between`` should find them with the benchmark's.
 
     ``centers`` (N, 3) and ``radii`` (N,) in world units, ``colors`` (N, 3) linear diffuse
     reflectance in [0, 1]; ``light_dir`` is the direction the light travels. Mitsuba's
@@ -121,7 +123,7 @@ def render_spheres(variant: str, centers: np.ndarray, radii: np.ndarray, colors:
         scene, out = Path(tmp, "scene.npz"), Path(tmp, "result.npz")
         np.savez(scene, centers=centers, radii=radii, colors=colors, light_dir=np.asarray(light_dir, np.float64),
                  size=np.array([width, height]), fov=np.array([hfov, vfov]), runs=runs, threads=threads,
-                 variant=variant)
+                 variant=variant, warm=int(between is not None))
         # Pin first: threads inherit the affinity of the thread that creates them.
         code = ("import os, sys; os.sched_setaffinity(0, {int(c) for c in sys.argv[1].split(',')})\n"
                 "sys.path.insert(0, sys.argv[2]); from peer_mitsuba import _worker; _worker(sys.argv[3], sys.argv[4])")
@@ -196,7 +198,7 @@ def _worker(scene_path: str, out_path: str) -> None:
     """Subprocess side of :func:`render_spheres`: build, warm up, time, write the result npz."""
     with np.load(scene_path) as f:
         s = {k: f[k] for k in f.files}
-    variant, threads, runs = str(s["variant"]), int(s["threads"]), int(s["runs"])
+    variant, threads, runs, warm = str(s["variant"]), int(s["threads"]), int(s["runs"]), int(s["warm"])
     import drjit as dr
     import mitsuba as mi
 
@@ -222,6 +224,8 @@ def _worker(scene_path: str, out_path: str) -> None:
         print("ready", flush=True)
         if not sys.stdin.readline():  # render_spheres runs its `between` meanwhile
             sys.exit("the benchmark stopped before the timed renders")
+        for _ in range(warm):
+            np.array(mi.render(scene, spp=1))
         start = time.perf_counter()
         image = np.array(mi.render(scene, spp=1), dtype=np.float32)
         renders.append(time.perf_counter() - start)

@@ -113,11 +113,15 @@ class _Program:
         return _get(self.words[at], OPCODE)
 
 
-#: The lists stream_scan sorts instructions into (control words: F and unknown opcodes),
-#: and per opcode value its list.
-_CONTROL, _CAMERA, _LIGHT, _PAIR = range(4)
-_KIND = np.full(1 << OPCODE.width, _CONTROL, np.uint8)
-_KIND[[_C, _L, _SE]] = _CAMERA, _LIGHT, _PAIR
+#: The lists stream_scan sorts instructions into: unknown opcodes, C, L, SE, then the frame
+#: control words by function (_FRAME + ER, NR, NF, LR); per opcode value its list (F: by
+#: its function).
+_UNKNOWN, _CAMERA, _LIGHT, _PAIR, _FRAME = range(5)
+if FUNC.width > 4:
+    raise ImportError("the function field outgrows csrc/kernels.c stream_scan")
+_LISTS = _FRAME + (1 << FUNC.width)
+_KIND = np.full(1 << OPCODE.width, _UNKNOWN, np.uint8)
+_KIND[[_F, _C, _L, _SE]] = _FRAME, _CAMERA, _LIGHT, _PAIR
 
 
 class _Stream:
@@ -127,29 +131,30 @@ class _Stream:
     def __init__(self, prog: _Program, start: int) -> None:
         self.prog, self.start = prog, start
         room = max(0, len(prog.words) - start)
-        lists, count = [np.empty(room, np.int64) for _ in range(4)], np.zeros(4, np.int64)
-        native.library().stream_scan(address(prog.words), len(prog.words), start, OPCODE.lo, OPCODE.width,
-                                     address(_KIND), *(address(a) for a in lists), address(count))
-        # Addresses of the instructions per kind (_KIND), in order; an SE's pair is one instruction.
+        lists, count = [np.empty(room, np.int64) for _ in range(_LISTS)], np.zeros(_LISTS, np.int64)
+        at = np.array([address(a) for a in lists], np.int64)
+        native.library().stream_scan(address(prog.words), len(prog.words), start, OPCODE.lo, OPCODE.width, FUNC.lo,
+                                     FUNC.width, address(_KIND), address(at), address(count))
+        # Addresses of the instructions per list (_KIND), in order; an SE's pair is one instruction.
         self.by_kind = [a[:c] for a, c in zip(lists, count.tolist())]
-        self._find_stop(self.by_kind[_CONTROL])
+        self._find_stop()
 
-    def _find_stop(self, control: np.ndarray) -> None:
-        """Classify the control words: the nfs before ``stop``, the nrs, the TS words."""
+    def _find_stop(self) -> None:
+        """The nfs before ``stop``, the nrs, the TS words."""
         prog, n = self.prog, len(self.prog.words)
-        words, frame = prog.words[control], prog.opcode(control) == _F
-        func = np.where(frame, _get(words, FUNC), -1)
-        nf, lr, self.nr, er = (control[func == int(f)] for f in (Func.NF, Func.LR, Func.NR, Func.ER))
+        er, self.nr, nf, lr = (self.by_kind[_FRAME + int(f)] for f in (Func.ER, Func.NR, Func.NF, Func.LR))
+        unknown = self.by_kind[_UNKNOWN]
         if prog.options.er_needs_zero:
             er = er[(er + 1 >= n) | (prog.words[np.minimum(er + 1, n - 1)] == 0)]
         if prog.options.mode == "hybrid":  # TS words select tables; elsewhere they are unknown opcodes
+            words = prog.words[unknown]
             ts = np.isin(words, _TS_WORDS)
-            self.ts_at = control[ts]
+            self.ts_at = unknown[ts]
             # The table code after k TS words of the stream (k = 0: 0, the pass's entry table).
             self.ts_codes = np.append(0, 1 + np.argmax(words[ts][:, None] == _TS_WORDS, axis=1))
-            errors = control[~frame & ~ts]
+            errors = unknown[~ts]
         else:
-            self.ts_at, self.ts_codes, errors = _NO_TS, _ENTRY_ONLY, control[~frame]
+            self.ts_at, self.ts_codes, errors = _NO_TS, _ENTRY_ONLY, unknown
         last = self.by_kind[_PAIR][-1:]
         trailing = last[last == n - 1]  # an SE in the last word
         ends = [(int(a[0]), kind) for a, kind in ((lr, "lr"), (er, "er"), (errors, "error"), (trailing, "error"))

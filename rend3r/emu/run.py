@@ -6,6 +6,7 @@ from collections import deque
 from contextlib import nullcontext
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 from time import perf_counter
 from typing import Callable, Sequence
 
@@ -39,12 +40,14 @@ def rgb444_display(rgb565: np.ndarray) -> np.ndarray:
     return ((((r << 1) | (r >> 3)) << 11) | (((g << 2) | (g >> 2)) << 5) | ((b << 1) | (b >> 3))).astype(np.uint16)
 
 
-def _renderer(options: EmuOptions):
-    if options.mode == "hybrid":
+@lru_cache(maxsize=None)
+def _renderer(mode: str):
+    """The render_frame of ``mode``, imported when first asked for."""
+    if mode == "hybrid":
         from .hybrid import render_frame as hybrid_frame
 
         return hybrid_frame
-    if options.mode == "raster":
+    if mode == "raster":
         from .raster import render_frame
 
         return render_frame
@@ -97,7 +100,7 @@ def run_program(
     """
     start = perf_counter()
     options = options or EmuOptions()
-    render = _renderer(options)
+    render = _renderer(options.mode)
     result = RunResult()
     planned = plan(words, options, frames)
     at_once = frames_at_once(options, planned.execution.frames, memory)

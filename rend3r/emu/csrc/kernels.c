@@ -484,24 +484,24 @@ typedef struct { f64x4 c[3], smin, smax; } Shapes4;
 
 /* The instructions met reading words linearly from address start (_Stream): an SE word
  * takes the next word as its SD whatever that word is (an SE in the last word has none),
- * any other word is one instruction. Each instruction's address goes to the list of its
- * opcode's kind (kind[opcode]: 0 control words and unknown opcodes, 1 C, 2 L, 3 SE), in
- * address order; count[kind] is how many each list got (room: n - start addresses each). */
-void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo, int32_t op_width,
-                 const uint8_t *kind, int64_t *control, int64_t *camera, int64_t *light, int64_t *pair,
-                 int64_t *count)
+ * any other word is one instruction. Each instruction's address goes to a list, in address
+ * order: list kind[opcode] (0 unknown opcodes, 1 C, 2 L, 3 SE), or for the frame-control
+ * opcode f_op (kind[f_op] is 4) list 4 + its function field (ER, NR, NF, LR). count[k] is
+ * how many list k got; each has room for n - start addresses. */
+void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo, int32_t op_width, int32_t func_lo,
+                 int32_t func_width, const uint8_t *kind, int64_t *const *lists, int64_t *count)
 {
-    uint32_t mask = (1u << op_width) - 1u;
-    int64_t c[4] = {0, 0, 0, 0};
+    uint32_t mask = (1u << op_width) - 1u, func_mask = (1u << func_width) - 1u;
+    int64_t c[4 + (1 << 4)] = {0};  /* func_width is at most 4 (processor.py checks) */
     for (int64_t i = start; i < n;) {
-        switch (kind[(words[i] >> op_lo) & mask]) {
-        case 1: camera[c[1]++] = i++; break;
-        case 2: light[c[2]++] = i++; break;
-        case 3: pair[c[3]++] = i; i += 2; break;
-        default: control[c[0]++] = i++; break;
-        }
+        uint32_t w = words[i];
+        int k = kind[(w >> op_lo) & mask];
+        if (k == 4)
+            k += (int)((w >> func_lo) & func_mask);
+        lists[k][c[k]++] = i;
+        i += k == 3 ? 2 : 1;
     }
-    for (int k = 0; k < 4; k++)
+    for (int k = 0; k < 4 + (1 << func_width); k++)
         count[k] = c[k];
 }
 

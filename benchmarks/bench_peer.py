@@ -296,7 +296,8 @@ def markdown(rows: list[Row], variants: list[str], notes: list[str], header: lis
                 value = r.ratio(precision, kind, variant)
                 cells.append("-" if value is None else f"{value:.3f} {verdict(value, limit)}")
             body.append(cells)
-        lines += ["", "Ratios (our time / Mitsuba's render time; lower is faster), against the targets:", "",
+        lines += ["", ("Ratios (our time / Mitsuba's render time; lower is faster), each the median over rounds of one "
+                       "run of ours then one Mitsuba render, each after untimed ones; against the targets:"), "",
                   *_table(["spheres", *(f"{label} (<= {limit:g})" for label, *_, limit in ratios)],
                           ["---:"] * (len(ratios) + 1), body)]
     lines += ["", *(f"- {note}" for note in notes)]

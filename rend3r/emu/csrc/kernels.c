@@ -485,8 +485,8 @@ typedef struct { f64x4 c[3], smin, smax; } Shapes4;
 /* The instructions met reading words linearly from address start (_Stream): an SE word
  * takes the next word as its SD whatever that word is (an SE in the last word has none),
  * any other word is one instruction. Each instruction's address goes to a list, in address
- * order: list kind[opcode] (0 unknown opcodes, 1 C, 2 L, 3 SE), or for the frame-control
- * opcode f_op (kind[f_op] is 4) list 4 + its function field (ER, NR, NF, LR). count[k] is
+ * order: list kind[opcode] (0 unknown opcodes, 1 C, 2 L, 3 SE), and for the frame-control
+ * opcode (its kind is 4) list 4 + the word's function field (ER, NR, NF, LR). count[k] is
  * how many list k got; each has room for n - start addresses. */
 void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo, int32_t op_width, int32_t func_lo,
                  int32_t func_width, const uint8_t *kind, int64_t *const *lists, int64_t *count)

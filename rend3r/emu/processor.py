@@ -117,9 +117,9 @@ class _Program:
 #: control words by function (_FRAME + ER, NR, NF, LR); per opcode value its list (F: by
 #: its function).
 _UNKNOWN, _CAMERA, _LIGHT, _PAIR, _FRAME = range(5)
-if FUNC.width > 4:
-    raise ImportError("the function field outgrows csrc/kernels.c stream_scan")
-_LISTS = _FRAME + (1 << FUNC.width)
+if FUNC.width != 2 or sorted(Func) != list(range(4)):
+    raise ImportError("csrc/kernels.c stream_scan sorts four frame-control functions of a two-bit field")
+_LISTS = _FRAME + 4
 _KIND = np.full(1 << OPCODE.width, _UNKNOWN, np.uint8)
 _KIND[[_F, _C, _L, _SE]] = _FRAME, _CAMERA, _LIGHT, _PAIR
 
@@ -134,7 +134,7 @@ class _Stream:
         lists, count = [np.empty(room, np.int64) for _ in range(_LISTS)], np.zeros(_LISTS, np.int64)
         at = np.array([address(a) for a in lists], np.int64)
         native.library().stream_scan(address(prog.words), len(prog.words), start, OPCODE.lo, OPCODE.width, FUNC.lo,
-                                     FUNC.width, address(_KIND), address(at), address(count))
+                                     address(_KIND), address(at), address(count))
         # Addresses of the instructions per list (_KIND), in order; an SE's pair is one instruction.
         self.by_kind = [a[:c] for a, c in zip(lists, count.tolist())]
         self._find_stop()

@@ -486,23 +486,42 @@ typedef struct { f64x4 c[3], smin, smax; } Shapes4;
  * takes the next word as its SD whatever that word is (an SE in the last word has none),
  * any other word is one instruction. Each instruction's address goes to a list, in address
  * order: list kind[opcode] (0 unknown opcodes, 1 C, 2 L, 3 SE), and for the frame-control
- * opcode (its kind is 4) list 4 + the word's function field (ER, NR, NF, LR). count[k] is
- * how many list k got; each has room for n - start addresses. */
+ * opcode (its kind is 4) list 4 + the word's two-bit function field (ER, NR, NF, LR).
+ * count[k] is how many list k got; each has room for n - start addresses. The counts stay
+ * in locals (an array indexed by the kind put a store and a load on each word's path). */
 void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo, int32_t op_width, int32_t func_lo,
-                 int32_t func_width, const uint8_t *kind, int64_t *const *lists, int64_t *count)
+                 const uint8_t *kind, int64_t *const *lists, int64_t *count)
 {
-    uint32_t mask = (1u << op_width) - 1u, func_mask = (1u << func_width) - 1u;
-    int64_t c[4 + (1 << 4)] = {0};  /* func_width is at most 4 (processor.py checks) */
-    for (int64_t i = start; i < n;) {
+    uint32_t mask = (1u << op_width) - 1u;
+    int64_t *unknown = lists[0], *camera = lists[1], *light = lists[2], *pair = lists[3];
+    int64_t *er = lists[4], *nr = lists[5], *nf = lists[6], *lr = lists[7];
+    int64_t c0 = 0, c1 = 0, c2 = 0, c3 = 0, c4 = 0, c5 = 0, c6 = 0, c7 = 0;
+    for (int64_t i = start; i < n;) {  /* by how often each comes: pairs, then C and L words */
         uint32_t w = words[i];
         int k = kind[(w >> op_lo) & mask];
-        if (k == 4)
-            k += (int)((w >> func_lo) & func_mask);
-        lists[k][c[k]++] = i;
-        i += k == 3 ? 2 : 1;
+        if (k == 3) {
+            pair[c3++] = i;
+            i += 2;
+        } else if (k == 1) {
+            camera[c1++] = i++;
+        } else if (k == 2) {
+            light[c2++] = i++;
+        } else if (k == 4) {
+            uint32_t f = (w >> func_lo) & 3u;
+            if (f == 0)
+                er[c4++] = i++;
+            else if (f == 1)
+                nr[c5++] = i++;
+            else if (f == 2)
+                nf[c6++] = i++;
+            else
+                lr[c7++] = i++;
+        } else {
+            unknown[c0++] = i++;
+        }
     }
-    for (int k = 0; k < 4 + (1 << func_width); k++)
-        count[k] = c[k];
+    int64_t c[8] = {c0, c1, c2, c3, c4, c5, c6, c7};
+    memcpy(count, c, sizeof c);
 }
 
 /* The SE/SD pairs whose SE words are at at[0..n) (_apply), each writing (index, prop, data)

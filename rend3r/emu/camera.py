@@ -6,7 +6,6 @@ Both return :class:`Rays` in working precision, one ray per pixel in row-major o
 
 from __future__ import annotations
 
-from copy import copy
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property, lru_cache
@@ -47,6 +46,15 @@ class Rays:
         """(xs, ys, z) when the directions are exactly (x[column], y[row], z), else None."""
         return (self.xs, self.ys, self.z) if self.rotation is None else None
 
+    def fresh(self) -> Rays:
+        """A copy that shares the arrays but not ``direction`` once computed (a shallow
+        copy of the fields, without copy.copy's reduce protocol)."""
+        rays = object.__new__(Rays)
+        fields = rays.__dict__
+        fields.update(self.__dict__)
+        fields.pop("direction", None)
+        return rays
+
     @cached_property
     def direction(self) -> Vec:
         """Every pixel's direction, row-major: three (pixels,) arrays."""
@@ -66,7 +74,7 @@ def camera_rays(scene: Scene, options: EmuOptions, arith: Arith) -> Rays:
     frames and runs after (read-only arrays); each call gets its own Rays, so a frame's
     per-pixel ``direction`` goes with it."""
     bits = tuple(scene.camera.get(i, 0) for i in _ray_props())
-    return copy(_rays(bits, options.camera, options.width, options.height, arith))
+    return _rays(bits, options.camera, options.width, options.height, arith).fresh()
 
 
 @lru_cache(maxsize=1)

@@ -164,7 +164,7 @@ class _Stream:
 
     def executed_before(self, at: int) -> int:
         """Instructions of this stream that start before address ``at``."""
-        return sum(int(a.searchsorted(at)) for a in self.by_kind)
+        return sum(int(a.searchsorted(at)) for a in self.by_kind if len(a))
 
     def error(self) -> Rend3rError:
         """The error at ``stop`` (kind "error")."""
@@ -226,11 +226,11 @@ _PAIR_FIELDS = np.array([(f.lo, f.width) for f in (SE_INDEX_HI, SE_INDEX_LO, PRO
 if SE_INDEX_HI.width + SE_INDEX_LO.width > 20 or max(PROP.width, SE_PROP2.width) > 5 or \
         max(SD_DATA.width, SD_DATA2.width) > 16:
     raise ImportError("the SE/SD fields outgrow csrc/kernels.c pair_record")
-#: Per table code, 1 where pairs go to (scene.objects, scene.triangles): in hybrid mode
+#: The scene's tables pairs go to, each with 1 per table code it takes: in hybrid mode
 #: those aimed at the triangle table go to ``triangles``, else all go to ``objects``.
 _TRIANGLE_CODE = (np.arange(len(_TABLES) + 1) == _CODE[Table.TRIANGLE]).astype(np.uint8)
-_WANTED = {True: (1 - _TRIANGLE_CODE, _TRIANGLE_CODE),
-           False: (np.ones(len(_TABLES) + 1, np.uint8), np.zeros(len(_TABLES) + 1, np.uint8))}
+_WANTED = {True: (("objects", 1 - _TRIANGLE_CODE), ("triangles", _TRIANGLE_CODE)),
+           False: (("objects", np.ones(len(_TABLES) + 1, np.uint8)),)}
 
 
 _MARKS = threading.local()
@@ -258,8 +258,6 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
     ranges of pairs on a team of ``jobs`` threads when there are many), then over the
     decoded pairs the writes, in order (threads that each took a range of rows spent
     nearly as long reading every pair as one thread writing them all)."""
-    if not wanted.any():
-        return
     records = np.empty(len(at), np.uint64)  # each pair decoded once, by pair_marks for pair_apply
     pairs = native.Pairs(address(words), len(words), address(at), len(at), address(_PAIR_FIELDS),
                          None if tables is None else address(tables), entry, address(wanted), address(_SE_NULL),
@@ -336,8 +334,8 @@ def _apply(stream: _Stream, lo: int, hi: int, scene: Scene, entry: int) -> None:
     if len(at):
         tables = stream.pair_tables(at)
         jobs = stream.prog.options.jobs or threads.available_cores()
-        for table, wanted in zip((scene.objects, scene.triangles), _WANTED[stream.prog.options.mode == "hybrid"]):
-            _write_pairs(stream.prog.words, at, tables, entry, wanted, table, jobs)
+        for table, wanted in _WANTED[stream.prog.options.mode == "hybrid"]:
+            _write_pairs(stream.prog.words, at, tables, entry, wanted, getattr(scene, table), jobs)
 
 
 def _run_pass(stream: _Stream, scene: Scene, on_nf: RenderHook | None, count: int, frames: int | None,

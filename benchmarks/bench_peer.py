@@ -255,9 +255,11 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
             share = statistics.median(r / c for r, c in zip(ratios, ceilings))
             target = f"{verdict(ratio, SPEEDUP, False)} (target >= {SPEEDUP:g}x)" if size == JOBS_SIZE \
                 else "(no target)"
+            low, _, high = statistics.quantiles(ratios, n=4)
             lines.append(f"jobs, {size:,} spheres, {precision} (unpinned, {len(cpus)} CPUs, {len(times[1])} "
                          f"alternating rounds): jobs=1 run {statistics.median(times[1]):.4f} s, jobs=2 run "
-                         f"{statistics.median(times[2]):.4f} s: {ratio:.2f}x faster {target}; two pinned "
+                         f"{statistics.median(times[2]):.4f} s: {ratio:.2f}x faster (quartiles of the rounds "
+                         f"{low:.2f}-{high:.2f}x) {target}; two pinned "
                          f"processes in the same rounds render {statistics.median(ceilings):.2f}x the frames of one "
                          f"(two_cpus.py), jobs=2 reaches {share:.0%} of that")
             print(lines[-1], flush=True)

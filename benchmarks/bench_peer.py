@@ -64,7 +64,7 @@ JOBS_ALSO = 65536  # jobs measured here too (no target: how the threads serve a 
 WARM_FRAMES = 3  # untimed frames before each timed one of the paired measurements (peer, jobs)
 JOBS_ROUNDS = 15  # alternating rounds of the jobs measurement at least (a frame's speed here drifts within seconds)
 #: (label, numerator, denominator, target): numerators are ours ("fp32 run"), denominators
-#: a Mitsuba variant's median render.
+#: a Mitsuba variant's render, paired round by round (measure).
 RATIOS = (("fp32 run / scalar", "fp32", "run", "scalar_rgb", FP32_VS_PEER),
           ("fp32 run / llvm", "fp32", "run", "llvm_ad_rgb", FP32_VS_PEER),
           ("fp32 render / scalar", "fp32", "render", "scalar_rgb", FP32_VS_PEER),
@@ -113,7 +113,8 @@ class Row:
     paired: dict[tuple[str, str, str], float] = field(default_factory=dict)
 
     def ratio(self, precision: str, kind: str, variant: str) -> float | None:
-        """Our ``kind`` time ("run" or "render") over the variant's render time, if measured."""
+        """The median over paired rounds of our ``kind`` time ("run" or "render") over the
+        variant's render time, if measured."""
         return self.paired.get((precision, kind, variant))
 
 
@@ -179,6 +180,9 @@ def measure(n: int, runs: int, variants: list[str]) -> Row:
         p = row.peer[variant] = Peer(r.build_seconds, r.median, float(np.mean(r.hit != (ref >= 0))))
         for (precision, kind), times in ours.items():
             row.paired[precision, kind, variant] = statistics.median(a / b for a, b in zip(times, r.render_seconds))
+        print("    ours in the rounds paired with it: " + ", ".join(
+            f"{precision} {kind} {statistics.median(times):.4f} s" for (precision, kind), times in ours.items()),
+            flush=True)
         print(f"  mitsuba {variant:11} build {p.build:8.4f} s  render {p.render:8.4f} s  "
               f"hit mask vs our fp64: {100 * p.disagree:.3f}% of pixels differ", flush=True)
     cells = []
@@ -241,7 +245,7 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
             options = {jobs: EmuOptions(precision=precision, width=WIDTH, height=HEIGHT, jobs=jobs) for jobs in (1, 2)}
             times: dict[int, list[float]] = {1: [], 2: []}
             ceilings = []
-            with TwoCpus(cpus, size, precision, WIDTH, HEIGHT) as two:
+            with TwoCpus(cpus, size, precision, WIDTH, HEIGHT, WARM_FRAMES) as two:
                 for _ in range(max(runs, JOBS_ROUNDS)):
                     for jobs, options_ in options.items():
                         for _ in range(WARM_FRAMES):
@@ -277,7 +281,9 @@ def markdown(rows: list[Row], variants: list[str], notes: list[str], header: lis
              ("Times in seconds, medians. Ours: *run* is the whole `run_program` call (decoding the program "
               "included), *render* the frame's render time; one core (`jobs=1`). Mitsuba: *render* is "
               "`mi.render` plus the copy to numpy, its scene build (objects and BVH) excluded and shown apart; "
-              "one core. *fp16 faithful*: the fp16 frame shows fp64's shape everywhere but at silhouettes."), ""]
+              "one core. *fp16 faithful*: the fp16 frame shows fp64's shape everywhere but at silhouettes. "
+              "Our times here are from our runs back to back; the ratios below pair each run of ours with a "
+              "Mitsuba render in the same seconds, so they need not equal the quotient of these columns."), ""]
     head = ["spheres", "fp16 run", "fp16 faithful", "fp32 run", "fp32 render", "fp64 run"]
     head += [f"{v} {what}" for v in variants for what in ("build", "render")]
     body = []

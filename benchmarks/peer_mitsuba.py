@@ -16,7 +16,10 @@ numpy, Dr.Jit or Mitsuba start a thread, with Dr.Jit's pool (which Mitsuba's sca
 renderer and scene loader use too) set to ``threads``. Build time (Mitsuba objects from the
 arrays, the scene, its BVH) is taken apart from render time: ``mi.render(scene, spp=1)`` plus
 the copy to numpy, which forces the lazy LLVM variant's kernels; one untimed warm-up
-render (the LLVM variant compiles its kernel there) precedes ``runs`` timed renders.
+render (the LLVM variant compiles its kernel there) precedes ``runs`` timed renders. The
+worker prints ``ready`` and waits for a line on its stdin before each timed render, so a
+benchmark can time its own renderer in between (``render_spheres``'s ``between``; each
+timed render then follows an untimed one, which doubles Mitsuba's part of the run).
 
     python benchmarks/peer_mitsuba.py [--variants scalar_rgb llvm_ad_rgb] [--sizes 1 16 256 4096 65536]
                                       [--runs 3] [--threads 1] [--check]
@@ -25,6 +28,7 @@ render (the LLVM variant compiles its kernel there) precedes ``runs`` timed rend
 from __future__ import annotations
 
 import argparse
+import contextlib
 import glob
 import importlib.util
 import math
@@ -132,14 +136,18 @@ def render_spheres(variant: str, centers: np.ndarray, radii: np.ndarray, colors:
                                      os.path.dirname(os.path.abspath(__file__)), str(scene), str(out)],
                                     env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=err, text=True)
             with proc:
-                for _ in range(runs):  # the worker waits for a line before each timed render
-                    if not _said(proc, "ready"):
-                        break
-                    if between is not None:
-                        between()
-                    proc.stdin.write("go\n")
-                    proc.stdin.flush()
-                proc.stdin.close()
+                try:
+                    for _ in range(runs):  # the worker waits for a line before each timed render
+                        if not _said(proc, "ready"):
+                            break
+                        if between is not None:
+                            between()
+                        proc.stdin.write("go\n")
+                        proc.stdin.flush()
+                except BrokenPipeError:  # the worker died: its exit status and stderr say why
+                    pass
+                with contextlib.suppress(BrokenPipeError):  # closed even when the flush fails
+                    proc.stdin.close()
                 proc.stdout.read()
             err.seek(0)
             if proc.returncode != 0:

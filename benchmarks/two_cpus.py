@@ -2,28 +2,30 @@
 CPU and rendering the same frame with jobs=1, timed alone and side by side.
 
 The ceiling of a round is 2 x (mean time alone) / (mean time side by side): the frames two
-cores finish in the time one core finishes one. A ``--jobs 2`` frame can be at most that
-much faster than a ``--jobs 1`` frame in the same seconds (it splits one frame over the
-same two cores, and also shares its decoding). On a VM whose host is busy, two busy vCPUs
+cores finish in the time one core finishes one. It is the yardstick for a ``--jobs 2``
+frame in the same seconds, which splits one frame over the same two cores and cannot
+split its serial part (caches may differ a little between one split frame and two
+processes, so a share above 100% is possible). On a VM whose host is busy, two busy vCPUs
 each run slower than one busy vCPU alone, and the ceiling falls well below 2.
 bench_peer.py measures it in the rounds of its jobs measurement, so that a missed speedup
-can be told apart from a machine that had no second core to give.
+can be told apart from a machine that had no second core to give. It assumes an
+otherwise idle machine: a third process on one CPU slows both measures of a round alike
+here, but a split frame far more (each of its passes waits for its slowest chunk; with a
+test suite running beside it, `--jobs 2` measured 0.95x against a ceiling of 1.98x).
 
-    python benchmarks/two_cpus.py [--size 4096] [--precision fp32] [--rounds 10]
+    python benchmarks/two_cpus.py [--size 4096] [--precision fp32] [--rounds 10] [--warm 3]
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import statistics
 import subprocess
 import sys
 import time
 from pathlib import Path
-
-WARM_FRAMES = 3  # untimed frames before each timed one, as bench_peer.py's jobs rounds
-
 
 def _worker(cpu: int, size: int, precision: str, width: int, height: int) -> None:
     """Renders on request: each line read (a count of untimed frames) is answered with
@@ -49,24 +51,34 @@ def _worker(cpu: int, size: int, precision: str, width: int, height: int) -> Non
 
 class TwoCpus:
     """Two worker processes pinned to the first two of ``cpus``, rendering the wall of
-    ``size`` spheres in ``precision``; a context manager (the workers end on exit)."""
+    ``size`` spheres in ``precision``, each timed frame after ``warm`` untimed ones; a
+    context manager (the workers end on exit)."""
 
-    def __init__(self, cpus: set[int], size: int, precision: str, width: int, height: int) -> None:
-        self.workers = [subprocess.Popen([sys.executable, str(Path(__file__).resolve()), "--worker", str(cpu),
-                                          "--size", str(size), "--precision", precision, "--width", str(width),
-                                          "--height", str(height)],
-                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-                        for cpu in sorted(cpus)[:2]]
-        for w in self.workers:
-            if w.stdout.readline().strip() != "ready":
-                self.close()
-                raise RuntimeError("a two_cpus.py worker did not start")
+    def __init__(self, cpus: set[int], size: int, precision: str, width: int, height: int, warm: int = 3) -> None:
+        if len(cpus) < 2:
+            raise ValueError(f"two CPUs needed, {len(cpus)} given")
+        self.warm, self.workers = warm, []
+        try:
+            for cpu in sorted(cpus)[:2]:
+                self.workers.append(subprocess.Popen(
+                    [sys.executable, str(Path(__file__).resolve()), "--worker", str(cpu), "--size", str(size),
+                     "--precision", precision, "--width", str(width), "--height", str(height)],
+                    stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True))
+            for w in self.workers:
+                if w.stdout.readline().strip() != "ready":
+                    raise RuntimeError(f"a two_cpus.py worker did not start (exit status {w.wait()})")
+        except BaseException:
+            self.close()
+            raise
 
     def _frames(self, which: list[int]) -> list[float]:
         for i in which:
-            self.workers[i].stdin.write(f"{WARM_FRAMES}\n")
+            self.workers[i].stdin.write(f"{self.warm}\n")
             self.workers[i].stdin.flush()
-        return [float(self.workers[i].stdout.readline()) for i in which]
+        answers = [self.workers[i].stdout.readline() for i in which]
+        if not all(answers):
+            raise RuntimeError("a two_cpus.py worker ended in the middle of a round")
+        return [float(a) for a in answers]
 
     def ceiling(self) -> float:
         """One round: each worker alone, then both at once; 2 x mean alone / mean together."""
@@ -75,8 +87,12 @@ class TwoCpus:
         return 2 * statistics.mean(alone) / statistics.mean(together)
 
     def close(self) -> None:
+        """Ends the workers (their stdin closed: they finish the loop) and waits for them."""
         for w in self.workers:
-            w.stdin.close()
+            with contextlib.suppress(BrokenPipeError):  # closed even when a dead worker's pipe fails the flush
+                w.stdin.close()
+        for w in self.workers:
+            w.stdout.close()
             w.wait()
 
     def __enter__(self) -> TwoCpus:
@@ -91,6 +107,7 @@ def main() -> int:
     ap.add_argument("--size", type=int, default=4096)
     ap.add_argument("--precision", default="fp32", choices=("fp16", "fp32", "fp64"))
     ap.add_argument("--rounds", type=int, default=10)
+    ap.add_argument("--warm", type=int, default=3, help="untimed frames before each timed one")
     ap.add_argument("--width", type=int, default=512)
     ap.add_argument("--height", type=int, default=384)
     ap.add_argument("--worker", type=int, help=argparse.SUPPRESS)  # the CPU of a worker process
@@ -102,7 +119,7 @@ def main() -> int:
     if len(cpus) < 2:
         print(f"not measured: this process may use {len(cpus)} CPU")
         return 0
-    with TwoCpus(cpus, args.size, args.precision, args.width, args.height) as two:
+    with TwoCpus(cpus, args.size, args.precision, args.width, args.height, args.warm) as two:
         rounds = [two.ceiling() for _ in range(args.rounds)]
     print(f"{args.size:,} spheres, {args.precision}: two pinned processes render {statistics.median(rounds):.2f}x "
           f"the frames of one (median of {args.rounds} rounds; {min(rounds):.2f}-{max(rounds):.2f})")

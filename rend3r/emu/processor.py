@@ -140,7 +140,8 @@ class _Stream:
         self._find_stop()
 
     def _find_stop(self) -> None:
-        """The nfs before ``stop``, the nrs, the TS words."""
+        """Where the stream stops and why (``stop``, ``kind``), the nfs before it, the nrs,
+        the TS words."""
         prog, n = self.prog, len(self.prog.words)
         er, self.nr, nf, lr = (self.by_kind[_FRAME + int(f)] for f in (Func.ER, Func.NR, Func.NF, Func.LR))
         unknown = self.by_kind[_UNKNOWN]

@@ -161,7 +161,7 @@ def measure(n: int, runs: int, variants: list[str]) -> Row:
                    for precision in compared}
         ours: dict[tuple[str, str], list[float]] = {(p, kind): [] for p in compared for kind in ("run", "render")}
 
-        def between() -> None:  # before each of Mitsuba's timed renders (and its untimed one): ours
+        def between(options=options, ours=ours) -> None:  # before each of Mitsuba's timed renders: ours
             for precision, options_ in options.items():
                 for _ in range(WARM_FRAMES):
                     run_program(wall.words, options_)

@@ -26,13 +26,15 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Self
+
+import walls
+
 
 def _worker(cpu: int, size: int, precision: str, width: int, height: int) -> None:
     """Renders on request: each line read (a count of untimed frames) is answered with
     the seconds of one more frame."""
     os.sched_setaffinity(0, {cpu})
-    import walls
-
     from rend3r.emu.options import EmuOptions
     from rend3r.emu.run import run_program
     from rend3r.memory import reuse_freed_memory
@@ -95,21 +97,31 @@ class TwoCpus:
             w.stdout.close()
             w.wait()
 
-    def __enter__(self) -> TwoCpus:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
 
 
+def _at_least(low: int):
+    """An argparse type: an integer of at least ``low``."""
+    def check(text: str) -> int:
+        value = int(text)
+        if value < low:
+            raise argparse.ArgumentTypeError(f"{value} is below {low}")
+        return value
+    return check
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--size", type=int, default=4096)
+    ap.add_argument("--size", type=int, default=4096, choices=sorted(walls.LAYOUT), help="spheres in the wall")
     ap.add_argument("--precision", default="fp32", choices=("fp16", "fp32", "fp64"))
-    ap.add_argument("--rounds", type=int, default=10)
-    ap.add_argument("--warm", type=int, default=3, help="untimed frames before each timed one")
-    ap.add_argument("--width", type=int, default=512)
-    ap.add_argument("--height", type=int, default=384)
+    ap.add_argument("--rounds", type=_at_least(1), default=10)
+    ap.add_argument("--warm", type=_at_least(0), default=3, help="untimed frames before each timed one")
+    ap.add_argument("--width", type=_at_least(1), default=512)
+    ap.add_argument("--height", type=_at_least(1), default=384)
     ap.add_argument("--worker", type=int, help=argparse.SUPPRESS)  # the CPU of a worker process
     args = ap.parse_args()
     if args.worker is not None:

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-from two_cpus import TwoCpus  # noqa: E402
+from two_cpus import TwoCpus
 
 CPUS = os.sched_getaffinity(0)
 

@@ -193,10 +193,10 @@ def shadow_pass(bnd, ok, lo, hi, dmin, u, tiny, overflow, *, chord=np.nan, unit=
     if unit is not None:
         p.unit = np.ascontiguousarray(unit, np.float64)
         p.behind, p.keys = np.empty((n, 3)), np.empty((n, 3))
-        b.unit, b.behind, b.keys = p.unit.ctypes.data, p.behind.ctypes.data, p.keys.ctypes.data
-    elif chord == chord:
+        b.unit, b.behind, b.keys = native.address(p.unit), native.address(p.behind), native.address(p.keys)
+    elif not np.isnan(chord):
         p.keys = np.empty((n, native.SK_COLUMNS))
-        b.point = p.keys.ctypes.data
+        b.point = native.address(p.keys)
     return p
 
 

@@ -73,8 +73,13 @@ def camera_rays(scene: Scene, options: EmuOptions, arith: Arith) -> Rays:
     camera gives the same rays, so the last few cameras' axes and terms are kept for the
     frames and runs after (read-only arrays); each call gets its own Rays, so a frame's
     per-pixel ``direction`` goes with it."""
+    return _rays(*camera_key(scene, options, arith)).fresh()
+
+
+def camera_key(scene: Scene, options: EmuOptions, arith: Arith) -> tuple:
+    """What the frame's rays depend on: equal keys give equal rays (camera_rays)."""
     bits = tuple(scene.camera.get(i, 0) for i in _ray_props())
-    return _rays(bits, options.camera, options.width, options.height, arith).fresh()
+    return bits, options.camera, options.width, options.height, arith
 
 
 @lru_cache(maxsize=1)

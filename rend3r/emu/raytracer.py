@@ -38,10 +38,11 @@ from ..isa.tables import PROP_LIMIT, SHAPE_TYPE_CODES
 from . import bounds, bvh, native, threads
 from .native import address
 from .arith import Arith
-from .camera import camera_rays
+from .camera import Rays, camera_key, camera_rays
 from .frame import Frame
 from .lights import POINT, Light, lights_from_scene
 from .options import EmuOptions
+from .recent import Recent
 from .scene import Scene, prop_index
 from .stats import FrameStats
 
@@ -69,8 +70,10 @@ class _Frame:
     index: np.ndarray
     bnd: np.ndarray
     bounded: np.ndarray  # uint8, 1 where the shape is bounded
-    lights: list[Light]
+    lights: tuple[Light, ...]
     light_rows: np.ndarray
+    light_frames: np.ndarray
+    scales: np.ndarray
     jobs: int
     shapes: native.Shapes
     tree: bvh.Tree
@@ -113,23 +116,68 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     hierarchy and, for a grid camera, the primary rays' bounds."""
     ar = options.arith
     dtype = native.dtype(ar)
-    rays = camera_rays(scene, options, ar)
-    cam = np.zeros(native.CAM_COLUMNS, dtype)
-    cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3] = [np.asarray(c, dtype) for c in rays.origin]
-    cam[native.CAM_TMIN], cam[native.CAM_TMAX], cam[native.CAM_Z] = rays.tmin, rays.tmax, rays.z
-    if rays.rotation is not None:  # the kernel turns (x[col], y[row], z) per pixel
-        cam[native.CAM_ROT:native.CAM_ROT + 4] = [np.asarray(c, dtype) for c in rays.rotation]
-    xs, ys = np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype)
+    cam = _CAMERAS.get(camera_key(scene, options, ar), lambda: _Camera.of(camera_rays(scene, options, ar), dtype))
     fmt = None if ar.native else native.Format.of(ar)
     jobs = options.jobs or threads.available_cores()
-    extent = _extent(cam, xs, ys, rays.rotation is not None)
-    sf, si, bnd, bounded, index, tree, primary = _shapes(scene, ar, fmt, cam, extent, jobs)
-    lights = lights_from_scene(scene, ar, options.light_model)
+    sf, si, bnd, bounded, index, tree, primary = _shapes(scene, ar, fmt, cam.block, cam.extent, jobs)
+    lit = _LIGHTS.get((tuple((i, tuple(p.items())) for i, p in scene.lights.items()), ar, options.light_model),
+                      lambda: _Lights.of(lights_from_scene(scene, ar, options.light_model), dtype))
     n = len(sf)
     view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
                          native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny, fmt)
-    return _Frame(ar, dtype, cam, xs, ys, rays.rotation is not None, sf, si, index, bnd, bounded, lights,
-                  _light_rows(lights, dtype), jobs, view, tree, primary)
+    return _Frame(ar, dtype, cam.block, cam.xs, cam.ys, cam.rotated, sf, si, index, bnd, bounded, lit.lights, lit.rows,
+                  lit.frames, lit.scales, jobs, view, tree, primary)
+
+
+@dataclass(frozen=True)
+class _Camera:
+    """A camera as the kernels take it (read-only arrays): the block (csrc/kernels.h CAM_*),
+    the axes, whether the directions are turned, and the primary directions' extent."""
+
+    block: np.ndarray
+    xs: np.ndarray
+    ys: np.ndarray
+    rotated: bool
+    extent: tuple[float, float] | None
+
+    @classmethod
+    def of(cls, rays: Rays, dtype: np.dtype) -> _Camera:
+        cam = np.zeros(native.CAM_COLUMNS, dtype)
+        cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3] = [np.asarray(c, dtype) for c in rays.origin]
+        cam[native.CAM_TMIN], cam[native.CAM_TMAX], cam[native.CAM_Z] = rays.tmin, rays.tmax, rays.z
+        if rays.rotation is not None:  # the kernel turns (x[col], y[row], z) per pixel
+            cam[native.CAM_ROT:native.CAM_ROT + 4] = [np.asarray(c, dtype) for c in rays.rotation]
+        xs, ys = np.ascontiguousarray(rays.xs, dtype), np.ascontiguousarray(rays.ys, dtype)
+        for a in (cam, xs, ys):
+            a.flags.writeable = False
+        rotated = rays.rotation is not None
+        return cls(cam, xs, ys, rotated, _extent(cam, xs, ys, rotated))
+
+
+@dataclass(frozen=True)
+class _Lights:
+    """The lights that are on and their tables (read-only arrays): the kernels' rows
+    (csrc/kernels.h LT_*), what their shadow rays' bounds need (LF_*) and the colour scales."""
+
+    lights: tuple[Light, ...]
+    rows: np.ndarray
+    frames: np.ndarray
+    scales: np.ndarray
+
+    @classmethod
+    def of(cls, lights: list[Light], dtype: np.dtype) -> _Lights:
+        rows = _light_rows(lights, dtype)
+        out = cls(tuple(lights), rows, _light_frames(rows), _scales(lights))
+        for a in (out.rows, out.frames, out.scales):
+            a.flags.writeable = False
+        return out
+
+
+#: The last few cameras and light sets set up, by what they are made of (camera_key; the
+#: lights' property words, precision and light model): animation frames and repeated runs
+#: mostly keep them.
+_CAMERAS: Recent[_Camera] = Recent(8)
+_LIGHTS: Recent[_Lights] = Recent(8)
 
 
 #: The shape table's columns the kernels read, and the type codes of the normal forms.
@@ -196,12 +244,11 @@ def trace_pixel(fr: _Frame, options: EmuOptions, x: int, y: int) -> PixelTrace:
     n, nl = len(fr.sf), len(fr.lights)
     band = _band_block(fr, options)
     band.row0 = y
-    scales = _scales(fr.lights)
     shape_out = np.zeros((n, native.TRACE_SHAPE_VALUES))
     light_out = np.zeros((nl, native.TRACE_LIGHT_VALUES))
     nearest = np.zeros(1, np.int64)
     colour = fr.kernel("trace_pixel")(byref(band), int(options.intensity_fixed), int(n > 1), address(fr.light_rows),
-                                      address(scales), nl, x, y, address(shape_out), address(light_out),
+                                      address(fr.scales), nl, x, y, address(shape_out), address(light_out),
                                       address(nearest))
     return PixelTrace(shape_out, light_out, int(nearest[0]), None if colour < 0 else int(colour))
 
@@ -245,12 +292,11 @@ def _bands(fr: _Frame, options: EmuOptions) -> tuple[native.Bands, list]:
     tree, floor, pc = primary
     band.pc, band.floor, band.tree = address(pc), address(floor), tree.view
     band.index, band.background = address(fr.index), options.background
-    frames, scales = _light_frames(fr.light_rows), _scales(fr.lights)
-    keep += [primary, frames, scales]
+    keep.append(primary)
     for name in ("directions", "nearest", "light_pass", "shadow_origins"):
         setattr(b, name, native.kernel_address(name, fr.ar))
     b.light_rows, b.light_row, b.lights = address(fr.light_rows), fr.light_rows.strides[0], len(fr.lights)
-    b.light_frames, b.scales = address(frames), address(scales)
+    b.light_frames, b.scales = address(fr.light_frames), address(fr.scales)
     b.fixed, b.item, b.bounded, b.items = int(options.intensity_fixed), fr.dtype.itemsize, address(fr.bounded), \
         len(fr.tree.items)
     b.overflow, b.jobs, b.avx2, b.chunk = fr.ar.overflow, fr.jobs, native.isa() == "avx2", bounds.SHAPE_CHUNK

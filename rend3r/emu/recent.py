@@ -1,0 +1,39 @@
+"""A bounded map of the last few values computed, by key (least recently used out).
+
+The renderers keep what a frame derives from a few dozen scene words (the camera's
+kernel block, the lights' rows) for the frames and runs after that have the same words:
+building them again took about a fifth of a small frame's Python.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from collections.abc import Callable, Hashable
+from threading import Lock
+from typing import Generic, TypeVar
+
+T = TypeVar("T")
+
+
+class Recent(Generic[T]):
+    """Up to ``size`` values by key; safe to share between threads (frames render side by
+    side), and a value made twice by two threads at once is the same value."""
+
+    def __init__(self, size: int) -> None:
+        if size < 1:
+            raise ValueError(f"a Recent map holds at least one value, not {size}")
+        self._size, self._values, self._lock = size, OrderedDict[Hashable, T](), Lock()
+
+    def get(self, key: Hashable, make: Callable[[], T]) -> T:
+        """The value kept for ``key``, else ``make()`` kept for it (made outside the lock)."""
+        with self._lock:
+            value = self._values.get(key)
+            if value is not None:
+                self._values.move_to_end(key)
+                return value
+        value = make()
+        with self._lock:
+            self._values[key] = value
+            if len(self._values) > self._size:
+                self._values.popitem(last=False)
+        return value

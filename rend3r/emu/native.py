@@ -194,6 +194,7 @@ _PLAIN = {
     "have_avx2": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
     "stream_scan": (None, [c_void_p, c_int64, c_int64, c_int32, c_int32, c_int32, c_void_p, c_void_p, c_void_p]),
+    "word_writes": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p]),
     "pair_apply": (None, [POINTER(Pairs), c_void_p, c_void_p]),
     "pair_marks_team": (None, [c_void_p, POINTER(Pairs), c_int64, c_void_p, c_void_p]),
     "mark_rows": (c_int64, [c_void_p, c_int64, c_void_p, c_void_p]),

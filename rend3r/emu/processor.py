@@ -56,7 +56,7 @@ def _null_mask(table: Table) -> np.ndarray:
     return mask
 
 
-_CAMERA_NULL, _LIGHT_NULL = _null_mask(Table.CAMERA), _null_mask(Table.LIGHT)
+_CAMERA_NULL, _LIGHT_NULL = (_null_mask(t).astype(np.uint8) for t in (Table.CAMERA, Table.LIGHT))
 _SE_NULL = np.stack([_null_mask(t) for t in _TABLES]).astype(np.uint8)  # row: table code - 1
 
 
@@ -67,11 +67,6 @@ class Execution:
     frames: int  # number of nf executed
     instructions: int  # instructions executed (an SE/SD pair counts once)
     halt: str  # "er", "end" (ran past the last word) or "frames" (the --frames bound)
-
-
-def _get(words: np.ndarray, f: Field) -> np.ndarray:
-    """Field ``f`` of every word (``Field.get`` over an array)."""
-    return (words >> f.lo) & ((1 << f.width) - 1)
 
 
 def _where(pc: int) -> str:
@@ -91,13 +86,6 @@ class _Writes(NamedTuple):
         i, j = self.at.searchsorted((lo, hi))
         return _Writes(self.at[i:j], self.index[i:j], self.prop[i:j], self.bits[i:j])
 
-    def take(self, keep: np.ndarray) -> _Writes:
-        """The writes where ``keep`` is True."""
-        if keep.all():
-            return self
-        keep = np.flatnonzero(keep)
-        return _Writes(self.at[keep], self.index[keep], self.prop[keep], self.bits[keep])
-
 
 class _Program:
     """The words (uint32), with the options that decide their meaning."""
@@ -108,9 +96,9 @@ class _Program:
         self.words = np.ascontiguousarray(words, np.uint32)
         self.options = options
 
-    def opcode(self, at: np.ndarray | int) -> np.ndarray:
-        """The opcode field of the words at ``at``."""
-        return _get(self.words[at], OPCODE)
+    def opcode(self, at: int) -> int:
+        """The opcode field of the word at ``at``."""
+        return OPCODE.get(int(self.words[at]))
 
 
 #: The lists stream_scan sorts instructions into: unknown opcodes, C, L, SE, then the frame
@@ -206,10 +194,15 @@ class _Stream:
         return self._word_writes(self._data(_LIGHT), _LIGHT_NULL, LIGHT_INDEX)
 
     def _word_writes(self, at: np.ndarray, null: np.ndarray, index: Field | None = None) -> _Writes:
-        words = self.prog.words[at]
-        prop = _get(words, PROP)
-        idx = _get(words, index) if index is not None else np.zeros(len(at), dtype=np.uint32)
-        return _Writes(at, idx, prop, _get(words, DATA).astype(np.uint16)).take(~null[prop])
+        """The writes of the C or L words at ``at`` whose property is not ``null`` (one
+        compiled pass: numpy took a dozen calls of 1-3 us each on a frame's few words)."""
+        n = len(at)
+        fields = _WRITE_FIELDS[index]
+        out = _Writes(np.empty(n, np.int64), np.empty(n, np.uint32), np.empty(n, np.uint32), np.empty(n, np.uint16))
+        kept = native.library().word_writes(address(self.prog.words), native.ptr(at, np.int64, (n,)), n,
+                                             address(fields), native.ptr(null, np.uint8, (PROP_LIMIT,)),
+                                             *(address(a) for a in out))
+        return out if kept == n else _Writes(*(a[:kept] for a in out))
 
     def pair_tables(self, at: np.ndarray) -> np.ndarray | None:
         """The table code in force at each SE address of ``at`` (0: the pass's entry
@@ -218,6 +211,13 @@ class _Stream:
             return None
         return np.ascontiguousarray(self.ts_codes[self.ts_at.searchsorted(at)], np.uint8)
 
+
+#: (lo, width) of the property, index (none for the camera) and data fields of a C or L
+#: word (csrc/kernels.c word_writes: a flag per property value, data of at most 16 bits).
+_WRITE_FIELDS = {index: np.array([PROP.lo, PROP.width, *((0, 0) if index is None else (index.lo, index.width)),
+                                  DATA.lo, DATA.width], np.int32) for index in (None, LIGHT_INDEX)}
+if 1 << PROP.width != PROP_LIMIT or DATA.width > 16 or LIGHT_INDEX.width > 31:
+    raise ImportError("the C and L fields outgrow csrc/kernels.c word_writes")
 
 #: (lo, width) of the fields the pair kernels read, in their order (csrc/kernels.c Pairs).
 _PAIR_FIELDS = np.array([(f.lo, f.width) for f in (SE_INDEX_HI, SE_INDEX_LO, PROP, SE_PROP2, SD_DATA, SD_DATA2)],

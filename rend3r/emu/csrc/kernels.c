@@ -524,6 +524,29 @@ void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo,
     memcpy(count, c, sizeof c);
 }
 
+/* The C or L words at addresses at[0..n) (_Stream camera, lights) as writes: those whose
+ * property (fields[0], [1]: its lo bit and width) is not null (null: a flag per value
+ * of that field) go, in address order, to out_at, out_index (fields[2], [3]; width 0: 0,
+ * at most 31), out_prop and out_bits (fields[4], [5]: the data, at most 16 bits).
+ * Returns how many. */
+int64_t word_writes(const uint32_t *words, const int64_t *at, int64_t n, const int32_t *fields, const uint8_t *null,
+                    int64_t *out_at, uint32_t *out_index, uint32_t *out_prop, uint16_t *out_bits)
+{
+    uint32_t prop_mask = (1u << fields[1]) - 1u, index_mask = (1u << fields[3]) - 1u;
+    uint32_t data_mask = (1u << fields[5]) - 1u;
+    int64_t kept = 0;
+    for (int64_t k = 0; k < n; k++) {
+        uint32_t w = words[at[k]], prop = (w >> fields[0]) & prop_mask;
+        if (null[prop])
+            continue;
+        out_at[kept] = at[k];
+        out_index[kept] = (w >> fields[2]) & index_mask;
+        out_prop[kept] = prop;
+        out_bits[kept++] = (uint16_t)((w >> fields[4]) & data_mask);
+    }
+    return kept;
+}
+
 /* The SE/SD pairs whose SE words are at at[0..n) (_apply), each writing (index, prop, data)
  * then (index, prop2, data2) to the table of its table code t (tables[k], or entry where
  * tables is NULL or tables[k] is 0); only pairs with wanted[t] are taken, and a write to a

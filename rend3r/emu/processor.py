@@ -50,7 +50,8 @@ _NO_TS, _ENTRY_ONLY = np.empty(0, np.int64), np.zeros(1, np.int64)  # a stream w
 
 
 def _null_mask(table: Table) -> np.ndarray:
-    """True for the property slots of ``table`` that are null (writing them stores nothing)."""
+    """True for the property slots of ``table`` that are null (writing them stores nothing)
+    (the camera's and lights' as uint8 flags for csrc/kernels.c word_writes)."""
     mask = np.zeros(PROP_LIMIT, dtype=bool)
     mask[[i for i, p in by_index(table).items() if p.vtype is ValueType.ZERO]] = True
     return mask

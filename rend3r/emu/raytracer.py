@@ -120,8 +120,8 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     fmt = None if ar.native else native.Format.of(ar)
     jobs = options.jobs or threads.available_cores()
     sf, si, bnd, bounded, index, tree, primary = _shapes(scene, ar, fmt, cam.block, cam.extent, jobs)
-    lit = _LIGHTS.get((tuple((i, tuple(p.items())) for i, p in scene.lights.items()), ar, options.light_model),
-                      lambda: _Lights.of(lights_from_scene(scene, ar, options.light_model), dtype))
+    lit = _LIGHTS.get((tuple((i, tuple(sorted(p.items()))) for i, p in sorted(scene.lights.items())), ar,
+                       options.light_model), lambda: _Lights.of(lights_from_scene(scene, ar, options.light_model), dtype))
     n = len(sf)
     view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
                          native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny, fmt)
@@ -129,7 +129,7 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
                   lit.frames, lit.scales, jobs, view, tree, primary)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class _Camera:
     """A camera as the kernels take it (read-only arrays): the block (csrc/kernels.h CAM_*),
     the axes, whether the directions are turned, and the primary directions' extent."""
@@ -154,10 +154,11 @@ class _Camera:
         return cls(cam, xs, ys, rotated, _extent(cam, xs, ys, rotated))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class _Lights:
-    """The lights that are on and their tables (read-only arrays): the kernels' rows
-    (csrc/kernels.h LT_*), what their shadow rays' bounds need (LF_*) and the colour scales."""
+    """The lights that are on and their tables (read-only arrays, the lights' values too):
+    the kernels' rows (csrc/kernels.h LT_*), what their shadow rays' bounds need (LF_*) and
+    the colour scales."""
 
     lights: tuple[Light, ...]
     rows: np.ndarray
@@ -168,7 +169,8 @@ class _Lights:
     def of(cls, lights: list[Light], dtype: np.dtype) -> _Lights:
         rows = _light_rows(lights, dtype)
         out = cls(tuple(lights), rows, _light_frames(rows), _scales(lights))
-        for a in (out.rows, out.frames, out.scales):
+        values = [v for lt in lights for v in (*lt.location, *lt.forward, lt.intensity) if isinstance(v, np.ndarray)]
+        for a in (out.rows, out.frames, out.scales, *values):
             a.flags.writeable = False
         return out
 

@@ -1,6 +1,6 @@
 """A bounded map of the last few values computed, by key (least recently used out).
 
-The renderers keep what a frame derives from a few dozen scene words (the camera's
+The raytracer keeps what a frame derives from a few dozen scene words (the camera's
 kernel block, the lights' rows) for the frames and runs after that have the same words:
 building them again took about a fifth of a small frame's Python.
 """
@@ -17,7 +17,8 @@ T = TypeVar("T")
 
 class Recent(Generic[T]):
     """Up to ``size`` values by key; safe to share between threads (frames render side by
-    side), and a value made twice by two threads at once is the same value."""
+    side). Two threads that miss the same key at once each make a value (equal ones, as
+    ``make`` must give for a key) and the later is kept."""
 
     def __init__(self, size: int) -> None:
         if size < 1:
@@ -34,6 +35,7 @@ class Recent(Generic[T]):
         value = make()
         with self._lock:
             self._values[key] = value
+            self._values.move_to_end(key)
             if len(self._values) > self._size:
                 self._values.popitem(last=False)
         return value

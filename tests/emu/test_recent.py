@@ -34,19 +34,26 @@ def test_refuses_an_empty_map():
 
 
 def test_threads_share_it():
-    recent: Recent[int] = Recent(4)
-    got: list[int] = []
+    """Four threads on seven keys of a map of four: each gets its key's value, whether
+    kept or made, and the map never holds more than four."""
+    recent: Recent[tuple[int, int]] = Recent(4)
+    wrong: list[tuple[int, tuple[int, int]]] = []
+    sizes: list[int] = []
 
     def work(k: int) -> None:
-        for i in range(2000):
-            got.append(recent.get((k + i) % 7, lambda i=i: (k + i) % 7))
+        for i in range(3000):
+            key = (k * 5 + i) % 7
+            value = recent.get(key, lambda key=key: (key, key * key))
+            if value != (key, key * key):
+                wrong.append((key, value))
+            sizes.append(len(recent._values))
 
     threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
     for t in threads:
         t.start()
     for t in threads:
         t.join()
-    assert len(got) == 8000 and set(got) <= set(range(7))
+    assert not wrong and len(sizes) == 12000 and max(sizes) <= 4
 
 
 @pytest.mark.parametrize("precision", ["fp16", "fp32"])

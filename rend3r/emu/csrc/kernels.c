@@ -526,7 +526,7 @@ void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo,
 
 /* The C or L words at addresses at[0..n) (_Stream camera, lights) as writes: those whose
  * property (fields[0], [1]: its lo bit and width) is not null (null: a flag per value
- * of that field) go, in address order, to out_at, out_index (fields[2], [3]; width 0: 0,
+ * of that field) go, in the order of at, to out_at, out_index (fields[2], [3]; width 0: 0,
  * at most 31), out_prop and out_bits (fields[4], [5]: the data, at most 16 bits).
  * Returns how many. */
 int64_t word_writes(const uint32_t *words, const int64_t *at, int64_t n, const int32_t *fields, const uint8_t *null,

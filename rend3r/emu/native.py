@@ -166,12 +166,19 @@ except ImportError:  # no compiled kernels: library() says so when one is first 
 
 def ptr(a: np.ndarray, dtype: type | np.dtype, shape: tuple[int | None, ...]) -> int:
     """The address of ``a`` after checking its dtype, C-contiguity and shape (None: any)."""
-    ok = a.dtype == dtype and a.flags.c_contiguous and a.ndim == len(shape)
-    for have, want in zip(a.shape, shape):  # a loop, not any(generator): this runs ~25 times a frame
-        ok = ok and (want is None or have == want)
-    if not ok:
-        raise TypeError(f"kernel argument: expected {np.dtype(dtype)} {shape}, got {a.dtype} {a.shape}")
-    return address(a)
+    if a.dtype == dtype and a.flags.c_contiguous and (a.shape == shape or _fits(a.shape, shape)):
+        return address(a)  # (this runs ~15 times a frame: the common case is one comparison each)
+    raise TypeError(f"kernel argument: expected {np.dtype(dtype)} {shape}, got {a.dtype} {a.shape}")
+
+
+def _fits(have: tuple[int, ...], shape: tuple[int | None, ...]) -> bool:
+    """Whether an array's shape ``have`` is ``shape``, None matching any length."""
+    if len(have) != len(shape):
+        return False
+    for n, want in zip(have, shape):  # a loop: all(generator) takes twice as long
+        if want is not None and n != want:
+            return False
+    return True
 
 
 #: Kernel suffix per (precision, flush subnormals); narrow formats' kernels are NARROW's (float

@@ -31,6 +31,12 @@ class Light:
     intensity: np.ndarray
 
 
+def lights_key(scene: Scene, arith: Arith, model: str = "spec") -> tuple:
+    """What :func:`lights_from_scene` depends on: equal keys give equal lights (the lights'
+    property words in index and property order, whatever order they were written in)."""
+    return tuple((i, tuple(sorted(p.items()))) for i, p in sorted(scene.lights.items())), arith, model
+
+
 def lights_from_scene(scene: Scene, arith: Arith, model: str = "spec") -> list[Light]:
     """Lights whose ``src`` low two bits say directional (1) or point (2), in index order.
 

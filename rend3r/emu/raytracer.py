@@ -35,14 +35,14 @@ import numpy as np
 from ..errors import Rend3rError
 from ..isa import Table, lookup
 from ..isa.tables import PROP_LIMIT, SHAPE_TYPE_CODES
+from ..recent import Recent
 from . import bounds, bvh, native, threads
 from .native import address
 from .arith import Arith
 from .camera import Rays, camera_key, camera_rays
 from .frame import Frame
-from .lights import POINT, Light, lights_from_scene
+from .lights import POINT, Light, lights_from_scene, lights_key
 from .options import EmuOptions
-from .recent import Recent
 from .scene import Scene, prop_index
 from .stats import FrameStats
 
@@ -120,8 +120,8 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     fmt = None if ar.native else native.Format.of(ar)
     jobs = options.jobs or threads.available_cores()
     sf, si, bnd, bounded, index, tree, primary = _shapes(scene, ar, fmt, cam.block, cam.extent, jobs)
-    lit = _LIGHTS.get((tuple((i, tuple(sorted(p.items()))) for i, p in sorted(scene.lights.items())), ar,
-                       options.light_model), lambda: _Lights.of(lights_from_scene(scene, ar, options.light_model), dtype))
+    lit = _LIGHTS.get(lights_key(scene, ar, options.light_model),
+                      lambda: _Lights.of(lights_from_scene(scene, ar, options.light_model), dtype))
     n = len(sf)
     view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
                          native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny, fmt)
@@ -175,9 +175,8 @@ class _Lights:
         return out
 
 
-#: The last few cameras and light sets set up, by what they are made of (camera_key; the
-#: lights' property words, precision and light model): animation frames and repeated runs
-#: mostly keep them.
+#: The last few cameras and light sets set up, by what they are made of (camera_key,
+#: lights_key): animation frames and repeated runs mostly keep them.
 _CAMERAS: Recent[_Camera] = Recent(8)
 _LIGHTS: Recent[_Lights] = Recent(8)
 

@@ -14,6 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..emu.trace import SHAPE_STAGES, Trace, decimals
+from ..recent import Recent
 from .params import RequestError
 
 #: Bytes of rendered frames kept for reuse (older option sets are dropped first).
@@ -98,17 +99,10 @@ class TraceCache:
     working precision at one pixel traces fp64 once."""
 
     def __init__(self, size: int = 8) -> None:
-        self.size = size
-        self._traces: OrderedDict[tuple, Trace] = OrderedDict()
+        self._traces: Recent[Trace] = Recent(size)
 
     def trace(self, version: int, words: Sequence[int], options, frame: int, x: int, y: int) -> Trace:
-        key = (version, options, frame, x, y)
-        if key not in self._traces:
-            self._traces[key] = trace(words, options, frame, x, y)
-            while len(self._traces) > self.size:
-                self._traces.popitem(last=False)
-        self._traces.move_to_end(key)
-        return self._traces[key]
+        return self._traces.get((version, options, frame, x, y), lambda: trace(words, options, frame, x, y))
 
 
 def trace(words: Sequence[int], options, frame: int, x: int, y: int) -> Trace:

@@ -10,8 +10,8 @@ import pytest
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.processor import execute
 from rend3r.emu.raytracer import render_frame
-from rend3r.emu.recent import Recent
 from rend3r.emu.reference import render_reference
+from rend3r.recent import Recent
 
 from .scenes import Prog
 from .test_engine_vs_reference import assert_same

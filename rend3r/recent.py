@@ -1,8 +1,9 @@
 """A bounded map of the last few values computed, by key (least recently used out).
 
 The raytracer keeps what a frame derives from a few dozen scene words (the camera's
-kernel block, the lights' rows) for the frames and runs after that have the same words:
-building them again took about a fifth of a small frame's Python.
+kernel block, the lights' rows) for the frames and runs after that have the same words
+(building them again took about a fifth of a small frame's Python); ``rend3r view`` keeps
+its last pixel traces.
 """
 
 from __future__ import annotations

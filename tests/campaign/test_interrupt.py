@@ -1,4 +1,8 @@
-"""Ctrl-C during a campaign on the local cluster: exit 130, nothing written, nothing left running."""
+"""Ctrl-C during a campaign on the local cluster: exit 130, nothing written.
+
+That the queued tasks are cancelled rather than run is checked by counting the tasks that
+ran (tests/campaign/test_runner.py), not by timing this process: Ctrl-C waits for the renders
+already running, seconds each here, longer on a loaded machine."""
 
 from __future__ import annotations
 
@@ -26,10 +30,8 @@ def test_ctrl_c_exits_130_and_writes_nothing(tmp_path):
     run = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(5)  # the cluster is up and rendering: the whole campaign takes far longer
     assert run.poll() is None, run.communicate()
-    sent = time.monotonic()
     run.send_signal(signal.SIGINT)
     _, err = run.communicate(timeout=60)
     assert run.returncode == 130, err
     assert err.endswith("rend3r: interrupted\n")
-    assert time.monotonic() - sent < 10  # the tasks not yet started were cancelled, not run (the rest takes > 15 s)
     assert not (tmp_path / "out").exists()

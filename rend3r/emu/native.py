@@ -86,7 +86,7 @@ class Band(Structure):
                 ("slot", c_void_p), ("sqd", c_void_p),
                 ("pt", c_void_p), ("nm", c_void_p), ("npix", c_int64), ("bad", c_void_p), ("nan_px", c_void_p),
                 ("acc", c_void_p), ("index", c_void_p), ("background", c_int32), ("rgb", c_void_p),
-                ("depth", c_void_p), ("prov", c_void_p)]
+                ("depth", c_void_p), ("prov", c_void_p), ("in_pass", c_void_p)]
 
 
 class Pairs(Structure):

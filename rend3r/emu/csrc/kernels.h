@@ -127,6 +127,8 @@ typedef struct {            /* the primary rays of one band of rows */
     uint16_t *rgb;          /* the band's pixels: RGB565, depth, provenance */
     float *depth;
     int32_t *prov;
+    const struct Bands *in_pass; /* a frame of one shape with lights: its lights, which the nearest-hit pass
+                                    applies (band.c render_band; else NULL) */
 } Band;
 
 typedef struct {            /* one light over one band */
@@ -222,7 +224,7 @@ enum { LF_PARALLEL = 0, LF_APEX = 1, LF_UNIT = 4, LF_LENGTH = 7, LF_AXES = 8, LF
 enum { BC_TESTS = 0, BC_SKIPPED = 1, BC_NAN_TESTS = 2, BC_NAN_RAYS = 3, BC_HITS = 4, BC_SHADOW_RAYS = 5,
        BC_COLUMNS = 6 };
 
-typedef struct {            /* a frame's bands, each rendered in one call (band.c render_band) */
+typedef struct Bands {      /* a frame's bands, each rendered in one call (band.c render_band) */
     Band *band;             /* the frame's fields (render_band sets a band's rows, arrays and pixels) */
     ChunkFn directions, nearest, light_pass, shadow_origins; /* the precision's pixel kernels */
     Bundle *primary;        /* a camera whose directions are measured per pixel: its primary bundle, fitted

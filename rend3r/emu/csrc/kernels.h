@@ -105,15 +105,16 @@ typedef struct {            /* the primary rays of one band of rows */
     const void *cam;        /* CAM_COLUMNS, working */
     const void *xs, *ys;    /* direction x per column, y per row, working */
     int32_t rotated;        /* turn (x, y, z) by the camera's rotation */
-    int32_t lit;            /* keep hit points and normals */
+    int32_t lit;            /* the frame has lights: keep hit points and normals for the light passes (unless
+                               in_pass) */
     int64_t width, row0;
     uint64_t row_magic;     /* floor(2**40 / width) + 1: band_row without a division */
     void *dirs;             /* pixels x 4: direction and |d|^2, working (rotated camera; else NULL) */
     const double *pc;       /* per shape PC_COLUMNS: the primary rays' cull data (bounds.h) */
     const double *floor;    /* depth floor per shape */
     Bvh tree;               /* the shapes, with the primary rays' boxes */
-    /* per pixel, for the light passes (lit only; without lights the nearest-hit pass
-     * finishes the pixels itself): */
+    /* per pixel, for the light passes (lit only; without lights, or with them applied in
+     * it, the nearest-hit pass finishes the pixels itself): */
     int32_t *slot;          /* nearest shape, -1 none */
     void *sqd;              /* its sq_dist, working */
     void *pt, *nm;          /* 3 x pixels (x row, y row, z row), working */

@@ -16,7 +16,8 @@ image does not depend on it). Per band:
 4. per light, the hierarchy's boxes for its shadow rays, from the box of the band's hit
    points, then the light's colour with its shadow rays (``light_pass``);
 5. colours, depth and provenance, packet by packet in the last light's pass (in the
-   nearest-hit pass when there are no lights).
+   nearest-hit pass when there are no lights, or one shape: a lone shape casts no
+   shadow, so that pass applies the lights itself and keeps nothing per pixel).
 
 ``docs/emulator.md`` sections 4-7 give the order of operations and why the hierarchy
 never changes a pixel; :mod:`.reference` is the plain renderer the tests compare with.
@@ -49,7 +50,7 @@ from .stats import FrameStats
 Progress = Callable[[float], None]
 #: Pixels per band at most: bounds the per-pixel working arrays (about 100 bytes per pixel).
 BAND_PIXELS = native.BAND_LIMIT
-#: Pixels per band at least (per thread), and per shape and bundle of rays more (_band_rows).
+#: Pixels per band at least, and per shape and bundle of rays more (_band_rows).
 BAND_LEAST, BAND_PER_SHAPE = 1 << 14, 64
 #: Smallest chunk of pixels handed to a thread, and the most chunks a pass takes per thread.
 MIN_CHUNK = 1 << 12
@@ -116,15 +117,17 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
 def _band_rows(fr: _Frame, width: int) -> int:
     """Rows per band. A lit frame of several shapes keeps per pixel what the nearest-hit pass
     found for the light passes (some 44 bytes a pixel in fp32): its bands stay near
-    BAND_LEAST pixels a thread, where those arrays stay in the cores' caches (a 16- or
-    256-sphere frame took a quarter less than in one band), unless the bounds each band
+    BAND_LEAST pixels, where those arrays stay in the cores' caches (a 16- or 256-sphere
+    frame took an eighth to a quarter less than in one band), unless the bounds each band
     fits to its own rays (every light's shadow bundle, and for a turned camera the primary
     one: a pass over the shapes each, some 20 ns a shape) would take more than a small part
-    of its work. Other frames keep nothing per pixel: bands of BAND_PIXELS."""
+    of its work. Other frames keep nothing per pixel: bands of BAND_PIXELS. Never by the
+    thread count: what each band's bounds skip shows in the stats' test counts, which must
+    not depend on it."""
     pixels = BAND_PIXELS
     if fr.lights and len(fr.sf) > 1:
         bundles = len(fr.lights) + (fr.primary is None)
-        pixels = min(pixels, max(BAND_LEAST * fr.jobs, BAND_PER_SHAPE * len(fr.sf) * bundles))
+        pixels = min(pixels, max(BAND_LEAST, BAND_PER_SHAPE * len(fr.sf) * bundles))
     return max(1, pixels // width)
 
 

@@ -94,7 +94,7 @@ class Pairs(Structure):
 
     _fields_ = [("words", c_void_p), ("n_words", c_int64), ("at", c_void_p), ("n", c_int64), ("fields", c_void_p),
                 ("tables", c_void_p), ("entry", c_int32), ("wanted", c_void_p), ("null", c_void_p),
-                ("records", c_void_p)]
+                ("records", c_void_p), ("avx2", c_int32)]
 
 
 class LightPass(Structure):

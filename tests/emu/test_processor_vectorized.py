@@ -333,3 +333,34 @@ def test_pairs_split_over_threads_keep_each_pairs_table():
     finally:
         processor.PAIR_CHUNK = chunk
     assert got == _outcome(reference, words, options, None)
+
+
+#: Runs of pairs back to back, as programs write shapes: a shape's pairs share its index,
+#: some write null properties only (they store nothing), and runs break at other words.
+_SHAPE_RUN = st.builds(
+    lambda index, pairs: [w for p, q, sd in pairs for w in (encode(ShapeSet(index, p, q, 0, 0))[0], sd)],
+    _INDEX, st.lists(st.tuples(_PROP, _PROP, _SD), min_size=1, max_size=12))
+_BREAK = st.one_of(_CAMERA, _LIGHT, _words(Func.NF), _SE_RUN, st.just([]))
+
+
+@pytest.mark.parametrize("instruction_set", ["base", "avx2"])
+@settings(max_examples=300)
+@given(st.lists(st.tuples(st.lists(_SHAPE_RUN, min_size=1, max_size=8), _BREAK), min_size=1, max_size=6),
+       st.sampled_from(["raytrace", "hybrid"]), st.integers(1, 4))
+def test_pairs_back_to_back_decode_alike_on_both_instruction_sets(instruction_set, runs, mode, jobs):
+    """Long runs of pairs, which AVX2 decodes eight at a time where they lie back to back
+    (csrc/kernels.c marks8), broken by other words at any pair: the scenes of the reference
+    interpreter with the baseline's pair at a time and with the AVX2 blocks."""
+    from rend3r.emu import native
+
+    if instruction_set == "avx2" and native.isa() != "avx2":
+        pytest.skip("this processor has no AVX2")
+    words = [NR] + [w for shapes, gap in runs for w in (*(w for shape in shapes for w in shape), *gap)] + [NF]
+    options = EmuOptions(mode=mode, jobs=jobs)
+    isa = native.isa
+    native.isa = lambda: instruction_set
+    try:
+        got = _outcome(vectorized, words, options, None)
+    finally:
+        native.isa = isa
+    assert got == _outcome(reference, words, options, None)

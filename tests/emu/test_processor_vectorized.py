@@ -349,18 +349,21 @@ _BREAK = st.one_of(_CAMERA, _LIGHT, _words(Func.NF), _SE_RUN, st.just([]))
        st.sampled_from(["raytrace", "hybrid"]), st.integers(1, 4))
 def test_pairs_back_to_back_decode_alike_on_both_instruction_sets(instruction_set, runs, mode, jobs):
     """Long runs of pairs, which AVX2 decodes eight at a time where they lie back to back
-    (csrc/kernels.c marks8), broken by other words at any pair: the scenes of the reference
-    interpreter with the baseline's pair at a time and with the AVX2 blocks."""
+    (csrc/kernels.c marks8), broken by other words at any pair, in ranges of a few blocks on
+    1-4 threads: the scenes of the reference interpreter with the baseline's pair at a time
+    and with the AVX2 blocks."""
     from rend3r.emu import native
 
     if instruction_set == "avx2" and native.isa() != "avx2":
         pytest.skip("this processor has no AVX2")
+    import rend3r.emu.processor as processor
+
     words = [NR] + [w for shapes, gap in runs for w in (*(w for shape in shapes for w in shape), *gap)] + [NF]
     options = EmuOptions(mode=mode, jobs=jobs)
-    isa = native.isa
-    native.isa = lambda: instruction_set
+    isa, chunk = native.isa, processor.PAIR_CHUNK
+    native.isa, processor.PAIR_CHUNK = (lambda: instruction_set), 12  # ranges of a block or two on each thread
     try:
         got = _outcome(vectorized, words, options, None)
     finally:
-        native.isa = isa
+        native.isa, processor.PAIR_CHUNK = isa, chunk
     assert got == _outcome(reference, words, options, None)

@@ -643,12 +643,12 @@ typedef struct {
  * anything reached through p): decoded into records[k], its index marked. Returns 0, or
  * -1 - k when its SD lies outside the words. */
 static inline __attribute__((always_inline)) int64_t mark_one(const Pairs *p, const uint32_t *words,
-                                                              const int64_t *at, uint64_t *records,
+                                                              const int64_t *at, int64_t n_words, uint64_t *records,
                                                               const PairFields *f, const uint8_t *nulls,
                                                               int one_table, int take, uint8_t *mark, int64_t k,
                                                               MarkState *m)
 {
-    if (at[k] < 0 || at[k] + 1 >= p->n_words)
+    if (at[k] < 0 || at[k] + 1 >= n_words)
         return -1 - k;
     uint32_t se = words[at[k]], sd = words[at[k] + 1];
     int32_t table;
@@ -748,16 +748,15 @@ static inline __attribute__((always_inline)) int64_t marks(const Pairs *p, uint8
     MarkState m = {0, -1, 0};
     for (int64_t k = 0; k < n;) {
 #if MARKS8
-        if (eight)
+        if (eight && k + 8 <= n && at[k + 7] == at[k] + 14)  /* else scattered pairs would try each block */
             k = marks8(words, at, n, n_words, records, &f, null_bits, take, mark, k, &m);
 #endif
         for (int64_t end = k + 8 < n ? k + 8 : n; k < end; k++)  /* a block not back to back, or the last pairs */
-            if (mark_one(p, words, at, records, &f, nulls, one_table, take, mark, k, &m) < 0)
+            if (mark_one(p, words, at, n_words, records, &f, nulls, one_table, take, mark, k, &m) < 0)
                 return -1 - k;
     }
     (void)null_bits;
     (void)eight;
-    (void)n_words;
     return m.top;
 }
 

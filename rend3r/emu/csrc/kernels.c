@@ -640,11 +640,12 @@ typedef struct {
 } MarkState;
 
 /* Pair k of marks (its arrays in the caller's locals: the byte stores to mark may alias
- * anything reached through p): decoded into records[k], its index marked. Returns 0, or
- * -1 - k when its SD lies outside the words. */
+ * anything reached through p): decoded into records[k], its index marked (one table:
+ * null_bits has bit p set where property p is null). Returns 0, or -1 - k when its SD lies
+ * outside the words. */
 static inline __attribute__((always_inline)) int64_t mark_one(const Pairs *p, const uint32_t *words,
                                                               const int64_t *at, int64_t n_words, uint64_t *records,
-                                                              const PairFields *f, const uint8_t *nulls,
+                                                              const PairFields *f, uint32_t null_bits,
                                                               int one_table, int take, uint8_t *mark, int64_t k,
                                                               MarkState *m)
 {
@@ -653,7 +654,7 @@ static inline __attribute__((always_inline)) int64_t mark_one(const Pairs *p, co
     uint32_t se = words[at[k]], sd = words[at[k] + 1];
     int32_t table;
     unsigned stores = !one_table ? pair_stores(p->wanted, p->null, p->tables, p->entry, f, k, se, &table)
-                      : take ? (unsigned)!nulls[FIELD(*f, se, 2)] | (unsigned)!nulls[FIELD(*f, se, 3)] << 1 : 0u;
+                      : take ? (~null_bits >> FIELD(*f, se, 2) & 1u) | (~null_bits >> FIELD(*f, se, 3) & 1u) << 1 : 0u;
     int64_t index = ((int64_t)FIELD(*f, se, 0) << f->hi_shift) | FIELD(*f, se, 1);
     records[k] = pair_record(stores, FIELD(*f, se, 2), FIELD(*f, se, 3), index, FIELD(*f, sd, 4), FIELD(*f, sd, 5));
     if (stores && !(m->stores && m->index == index)) {
@@ -738,13 +739,11 @@ static inline __attribute__((always_inline)) int64_t marks(const Pairs *p, uint8
     int64_t n = p->n, n_words = p->n_words;
     PairFields f = pair_fields(p);
     uint64_t *records = p->records;
-    uint8_t nulls[32];  /* one table: its null row and whether it is taken, read once (the byte stores may alias) */
+    /* one table: its null row as bits and whether it is taken, read once (the byte stores may alias) */
     int take = one_table && p->wanted[p->entry], eight = MARKS8 && one_table && p->avx2;
     uint32_t null_bits = 0;
-    if (one_table)
-        memcpy(nulls, p->null + 32 * (p->entry - 1), sizeof nulls);
     for (int i = 0; one_table && i < 32; i++)
-        null_bits |= (uint32_t)(nulls[i] != 0) << i;
+        null_bits |= (uint32_t)(p->null[32 * (p->entry - 1) + i] != 0) << i;
     MarkState m = {0, -1, 0};
     for (int64_t k = 0; k < n;) {
 #if MARKS8
@@ -752,10 +751,9 @@ static inline __attribute__((always_inline)) int64_t marks(const Pairs *p, uint8
             k = marks8(words, at, n, n_words, records, &f, null_bits, take, mark, k, &m);
 #endif
         for (int64_t end = k + 8 < n ? k + 8 : n; k < end; k++)  /* a block not back to back, or the last pairs */
-            if (mark_one(p, words, at, n_words, records, &f, nulls, one_table, take, mark, k, &m) < 0)
+            if (mark_one(p, words, at, n_words, records, &f, null_bits, one_table, take, mark, k, &m) < 0)
                 return -1 - k;
     }
-    (void)null_bits;
     (void)eight;
     return m.top;
 }

@@ -117,8 +117,9 @@ class Campaign:
         try:
             if self.scheduler == LOCAL:
                 slots = self.workers or available_cores()
-                shape = {"n_workers": slots, "threads_per_worker": 1} if self.processes else \
-                    {"n_workers": 1, "threads_per_worker": slots}
+                # worker processes tune their allocator as the rend3r command does (rend3r/memory.py)
+                shape = {"n_workers": slots, "threads_per_worker": 1, "preload": ["rend3r.memory"]} \
+                    if self.processes else {"n_workers": 1, "threads_per_worker": slots}
                 with ctrl_c_ignored():  # worker processes inherit it: a Ctrl-C stops the run here, which stops them
                     # no dashboard; the scheduler's HTTP server on any free port of the loopback (its
                     # default, 8787, is taken by another campaign running here, with a warning)

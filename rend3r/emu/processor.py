@@ -120,8 +120,8 @@ class _Stream:
     def __init__(self, prog: _Program, start: int) -> None:
         self.prog, self.start = prog, start
         room = max(0, len(prog.words) - start)
-        lists, count = [np.empty(room, np.int64) for _ in range(_LISTS)], np.zeros(_LISTS, np.int64)
-        at = np.array([address(a) for a in lists], np.int64)
+        lists, count = np.empty((_LISTS, room), np.int64), np.zeros(_LISTS, np.int64)
+        at = address(lists) + 8 * room * np.arange(_LISTS, dtype=np.int64)
         native.library().stream_scan(address(prog.words), len(prog.words), start, OPCODE.lo, OPCODE.width, FUNC.lo,
                                      address(_KIND), address(at), address(count))
         # Addresses of the instructions per list (_KIND), in order; an SE's pair is one instruction.
@@ -179,6 +179,8 @@ class _Stream:
 
     def table_after(self, entry: int) -> int:
         """The table code in force at ``stop`` for a pass entered with ``entry``."""
+        if not len(self.ts_at):
+            return entry
         return int(self.ts_codes[self.ts_at.searchsorted(self.stop)]) or entry
 
     def _data(self, kind: int) -> np.ndarray:
@@ -274,7 +276,7 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
         bad = [len(at) * k // count - 1 - t for k, t in enumerate(tops.tolist()) if t < 0]
         if bad:
             raise Rend3rError(f"{_where(int(at[bad[0]]))}: an SE word without its SD")
-        top = int(tops.max())
+        top = max(tops.tolist())
         if top:
             row_of = table.grow(mark, top)
             lib.pair_apply(byref(pairs), address(row_of), native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))

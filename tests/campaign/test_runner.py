@@ -218,3 +218,12 @@ def test_two_local_clusters_at_once_say_nothing(processes):
         with Campaign("local", workers=1, processes=processes) as second:
             assert second.map(abs, [(-3,)], ["abs"], Counter()) == [3]
         assert first.map(abs, [(-2,)], ["abs"], Counter()) == [2]
+
+
+@needs_dask
+def test_local_worker_processes_tune_their_allocator():
+    from rend3r.memory import reuse_freed_memory
+
+    with Campaign("local", workers=2, processes=True) as campaign:  # the preload has called it once in each
+        calls = campaign._client.run(reuse_freed_memory.cache_info)
+    assert [info.currsize for info in calls.values()] == [1, 1]

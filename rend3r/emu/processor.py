@@ -84,7 +84,9 @@ class _Writes(NamedTuple):
     bits: np.ndarray
 
     def between(self, lo: int, hi: int) -> _Writes:
-        i, j = self.at.searchsorted((lo, hi))
+        i, j = self.at.searchsorted((lo, hi)).tolist()
+        if i == 0 and j == len(self.at):
+            return self
         return _Writes(self.at[i:j], self.index[i:j], self.prop[i:j], self.bits[i:j])
 
 
@@ -145,12 +147,12 @@ class _Stream:
             errors = unknown[~ts]
         else:
             self.ts_at, self.ts_codes, errors = _NO_TS, _ENTRY_ONLY, unknown
-        last = self.by_kind[_PAIR][-1:]
-        trailing = last[last == n - 1]  # an SE in the last word
-        ends = [(int(a[0]), kind) for a, kind in ((lr, "lr"), (er, "er"), (errors, "error"), (trailing, "error"))
-                if len(a)]
+        pairs = self.by_kind[_PAIR]
+        ends = [(int(a[0]), kind) for a, kind in ((lr, "lr"), (er, "er"), (errors, "error")) if len(a)]
+        if len(pairs) and pairs[-1] == n - 1:  # an SE in the last word
+            ends.append((n - 1, "error"))
         self.stop, self.kind = min(ends, default=(n, "end"))
-        self.nfs = nf[nf < self.stop]
+        self.nfs = nf[:nf.searchsorted(self.stop)]
 
     def executed_before(self, at: int) -> int:
         """Instructions of this stream that start before address ``at``."""

@@ -27,6 +27,11 @@ def prop_index(table: Table, name: str) -> int:
     return prop.index
 
 
+#: An empty table's arrays, shared (read-only: writes replace them, never write into them).
+_NO_INDEX, _NO_VALUES = np.empty(0, dtype=np.int64), np.zeros((0, PROP_LIMIT), dtype=np.uint16)
+_NO_INDEX.flags.writeable = _NO_VALUES.flags.writeable = False
+
+
 class ObjectTable:
     """Shapes or triangles: ``index`` (sorted unique int64: every index written since the
     last clear) and ``values`` ((n, 32) uint16: property words, 0 where never written)."""
@@ -35,8 +40,7 @@ class ObjectTable:
         self.clear()
 
     def clear(self) -> None:
-        self.index = np.empty(0, dtype=np.int64)
-        self.values = np.zeros((0, PROP_LIMIT), dtype=np.uint16)
+        self.index, self.values = _NO_INDEX, _NO_VALUES
 
     def __len__(self) -> int:
         return len(self.index)
@@ -50,13 +54,16 @@ class ObjectTable:
             raise ValueError(f"grow: the marks must be {SHAPE_INDEX_LIMIT} bytes")
         from .native import address, library  # the compiled pass: numpy's nonzero and scatter took twice as long
 
-        top = max(top, int(self.index[-1]) + 1 if len(self.index) else 0)
-        mark[self.index] = 1
+        had = len(self.index)
+        if had:
+            top = max(top, int(self.index[-1]) + 1)
+            mark[self.index] = 1
         row_of, merged = np.empty(top, np.int32), np.empty(top, np.int64)
         merged = merged[:library().mark_rows(address(mark), top, address(row_of), address(merged))]
-        if len(merged) > len(self.index):
+        if len(merged) > had:
             values = np.zeros((len(merged), PROP_LIMIT), dtype=np.uint16)
-            values[row_of[self.index]] = self.values
+            if had:
+                values[row_of[self.index]] = self.values
             self.index, self.values = merged, values
         return row_of
 

@@ -64,6 +64,18 @@ def parse_scheduler(text: str) -> str:
     return value
 
 
+#: The module every local worker process preloads (its dask_setup tunes the allocator).
+_PRELOAD = "rend3r.memory"
+
+
+def _configured_preloads() -> list[str]:
+    """The worker preloads of the user's Dask configuration (a name or a list of them)."""
+    import dask
+
+    value = dask.config.get("distributed.worker.preload", default=[])
+    return [value] if isinstance(value, str) else list(value or [])
+
+
 def dask_installed() -> bool:
     """Whether ``dask.distributed`` can be imported (without importing it)."""
     from importlib.util import find_spec
@@ -117,8 +129,9 @@ class Campaign:
         try:
             if self.scheduler == LOCAL:
                 slots = self.workers or available_cores()
-                # worker processes tune their allocator as the rend3r command does (rend3r/memory.py)
-                shape = {"n_workers": slots, "threads_per_worker": 1, "preload": ["rend3r.memory"]} \
+                # worker processes tune their allocator as the rend3r command does (rend3r/memory.py),
+                # after the preloads of the user's Dask config (an explicit list replaces them)
+                shape = {"n_workers": slots, "threads_per_worker": 1, "preload": [*_configured_preloads(), _PRELOAD]} \
                     if self.processes else {"n_workers": 1, "threads_per_worker": slots}
                 with ctrl_c_ignored():  # worker processes inherit it: a Ctrl-C stops the run here, which stops them
                     # no dashboard; the scheduler's HTTP server on any free port of the loopback (its

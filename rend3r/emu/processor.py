@@ -123,7 +123,7 @@ class _Stream:
         self.prog, self.start = prog, start
         room = max(0, len(prog.words) - start)
         lists, count = np.empty((_LISTS, room), np.int64), np.zeros(_LISTS, np.int64)
-        at = address(lists) + 8 * room * np.arange(_LISTS, dtype=np.int64)
+        at = address(lists) + lists.strides[0] * np.arange(_LISTS, dtype=np.int64)
         native.library().stream_scan(address(prog.words), len(prog.words), start, OPCODE.lo, OPCODE.width, FUNC.lo,
                                      address(_KIND), address(at), address(count))
         # Addresses of the instructions per list (_KIND), in order; an SE's pair is one instruction.

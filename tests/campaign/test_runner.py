@@ -227,3 +227,20 @@ def test_local_worker_processes_tune_their_allocator():
     with Campaign("local", workers=2, processes=True) as campaign:  # the preload has called it once in each
         calls = campaign._client.run(reuse_freed_memory.cache_info)
     assert [info.currsize for info in calls.values()] == [1, 1]
+
+
+@needs_dask
+def test_the_users_worker_preloads_still_run(tmp_path, monkeypatch):
+    import dask
+
+    (tmp_path / "users_preload.py").write_text(
+        "import os\n\n\ndef dask_setup(worker):\n"
+        "    open(os.path.join(os.environ['PRELOAD_MARKS'], str(os.getpid())), 'w').close()\n")
+    marks = tmp_path / "marks"
+    marks.mkdir()
+    monkeypatch.syspath_prepend(str(tmp_path))  # spawned workers get this process's sys.path
+    monkeypatch.setenv("PRELOAD_MARKS", str(marks))
+    with dask.config.set({"distributed.worker.preload": ["users_preload"]}):
+        with Campaign("local", workers=2, processes=True) as campaign:
+            pids = set(campaign._client.run(os.getpid).values())
+    assert {int(p.name) for p in marks.iterdir()} == pids

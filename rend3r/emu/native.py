@@ -181,6 +181,9 @@ def _fits(have: tuple[int, ...], shape: tuple[int | None, ...]) -> bool:
     return True
 
 
+#: The kernels' builds, each instruction set also running the ones before it: portable, AVX2
+#: (with F16C), AVX-512 (F, VL, BW and DQ, on the AVX2 build's eight lanes).
+INSTRUCTION_SETS = ("base", "avx2", "avx512")
 #: Kernel suffix per (precision, flush subnormals); narrow formats' kernels are NARROW's (float
 #: lanes, csrc/fnarrow.h), every other format's FORMAT's (double lanes, csrc/fformat.h).
 SUFFIXES = {("fp16", True): "h16", ("fp16", False): "h16i", ("fp32", True): "f32", ("fp32", False): "f32",
@@ -199,6 +202,7 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
 _PLAIN = {
     "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
     "have_avx2": (c_int32, []),
+    "have_avx512": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
     "stream_scan": (None, [c_void_p, c_int64, c_int64, c_int32, c_int32, c_int32, c_void_p, c_void_p, c_void_p]),
     "word_writes": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p]),
@@ -223,24 +227,38 @@ def library() -> ctypes.CDLL:
     table = dict(_PLAIN)
     for name, sig in _SUFFIXED.items():
         for suffix in {*SUFFIXES.values(), NARROW, FORMAT}:
-            for isa in ("base", "avx2"):
+            for isa in INSTRUCTION_SETS:
                 table[f"{name}_{suffix}_{isa}"] = sig
-    for isa in ("base", "avx2"):
+    for isa in INSTRUCTION_SETS:
         table[f"round_array_{NARROW}_{isa}"] = (None, [c_void_p, c_void_p, c_int64, POINTER(Format)])
     for name, (restype, argtypes) in table.items():
         fn = getattr(lib, name, None)
-        if fn is not None:  # the AVX2 build exists on x86-64 only
+        if fn is not None:  # the AVX2 and AVX-512 builds exist on x86-64 only
             fn.restype, fn.argtypes = restype, argtypes
     return lib
 
 
 @lru_cache(maxsize=1)
 def isa() -> str:
-    """The instruction set the kernels run in: "avx2" where the processor has it, else
-    "base" (the same values either way; ``REND3R_ISA=base`` forces the baseline)."""
+    """The instruction set the kernels run in, of INSTRUCTION_SETS: the last one the processor
+    runs, up to ``REND3R_ISA`` if set (the same values in every one)."""
+    wanted = os.environ.get("REND3R_ISA") or INSTRUCTION_SETS[-1]
+    if wanted not in INSTRUCTION_SETS:
+        raise Rend3rError(f"REND3R_ISA={wanted!r}: choose one of {', '.join(INSTRUCTION_SETS)}")
+    return next(s for s in reversed(INSTRUCTION_SETS[:INSTRUCTION_SETS.index(wanted) + 1]) if runs(s))
+
+
+def runs(instruction_set: str) -> bool:
+    """Whether this build and processor run the kernels of ``instruction_set``."""
     lib = library()
-    wanted = os.environ.get("REND3R_ISA", "avx2")
-    return "avx2" if wanted == "avx2" and hasattr(lib, "nearest_f32_avx2") and lib.have_avx2() else "base"
+    return instruction_set == "base" or (hasattr(lib, f"nearest_f32_{instruction_set}")
+                                         and bool(getattr(lib, f"have_{instruction_set}")()))
+
+
+def avx2() -> bool:
+    """Whether the passes that have an AVX2 copy and no other (the pairs' decoding, the
+    shapes' bounds: csrc/kernels.c, csrc/setup.c) take it: under either vector build."""
+    return isa() != "base"
 
 
 def narrow_format(f: FloatFormat) -> bool:
@@ -286,7 +304,7 @@ def _address(symbol: str) -> int:
 
 def round_narrow(values: np.ndarray, ar: Arith, instruction_set: str | None = None) -> np.ndarray:
     """float32 values rounded to ``ar``'s narrow format by the narrow kernels' rounding (for
-    tests; ``instruction_set``: "base" or "avx2", default the one in use)."""
+    tests; ``instruction_set``: one of INSTRUCTION_SETS, default the one in use)."""
     if ar.stages or not narrow_format(ar.format):
         raise ValueError(f"{ar.label} is not a narrow format")
     a = np.ascontiguousarray(values, np.float32)

@@ -267,7 +267,7 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
     records = np.empty(len(at), np.uint64)  # each pair decoded once, by pair_marks for pair_apply
     pairs = native.Pairs(address(words), len(words), address(at), len(at), address(_PAIR_FIELDS),
                          None if tables is None else address(tables), entry, address(wanted), address(_SE_NULL),
-                         address(records), native.isa() == "avx2")
+                         address(records), native.avx2())
     lib, mark, top = native.library(), _marks(), -1
     count = threads.parts(len(at), jobs, PAIR_CHUNK)
     tops = np.empty(count, np.int64)

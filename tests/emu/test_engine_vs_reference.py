@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+import pytest
 from hypothesis import event, given, settings, strategies as st
 
 from rend3r.emu.frame import Frame
@@ -296,6 +297,34 @@ def test_random_crowds(cam, lights, shapes, ties, prec):
     and the list of shapes outside the tree, for primary and shadow rays."""
     options = EmuOptions(precision=prec[0], subnormals=prec[1], width=24, height=18)
     check(program(cam, lights, shapes, ties, options), options)
+
+
+@settings(max_examples=120, derandomize=True)
+@given(*scene_args[:-1], st.one_of(precision, other_format), st.booleans())
+def test_every_instruction_set_renders_alike(cam, lights, shapes, ties, prec, wall):
+    """The kernels' builds this processor runs (portable, AVX2, AVX-512; the other tests
+    run the one in use): the same pixels, depth bits, provenance and counts, on random
+    scenes or walls of spheres several deep."""
+    from rend3r.emu import native
+
+    sets = [s for s in native.INSTRUCTION_SETS if native.runs(s)]
+    if len(sets) < 2:
+        pytest.skip("this processor runs one build of the kernels")
+    options = EmuOptions(precision=prec[0], subnormals=prec[1], width=24, height=18)
+    if wall:
+        cam, shapes = _columns(3, 3, 0.5, 6, (1.0, 1.0, 1.0), shapes[0]["rot"], 0.15)
+    scene, chosen = scene_of(program(cam, lights, shapes, ties, options), options), native.isa
+    try:
+        renders = []
+        for name in sets:
+            native.isa = lambda name=name: name
+            renders.append(render_frame(scene, options))
+    finally:
+        native.isa = chosen
+    (first, counts), rest = renders[0], renders[1:]
+    for frame, other in rest:
+        assert_same(first, frame)
+        assert replace(other, seconds=0) == replace(counts, seconds=0)
 
 
 def test_value_types_are_what_the_tables_say():

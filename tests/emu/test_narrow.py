@@ -53,10 +53,10 @@ def _same_bits(got: np.ndarray, want: np.ndarray) -> np.ndarray:
     return (got.view(np.uint32) == want.view(np.uint32)) | (np.isnan(got) & np.isnan(want))
 
 
-@pytest.mark.parametrize("instruction_set", ["base", "avx2"])
+@pytest.mark.parametrize("instruction_set", native.INSTRUCTION_SETS)
 def test_rounding_at_every_boundary_of_every_narrow_format(instruction_set):
-    if instruction_set == "avx2" and native.isa() != "avx2":
-        pytest.skip("this processor does not run the AVX2 kernels")
+    if not native.runs(instruction_set):
+        pytest.skip(f"this processor does not run the {instruction_set} kernels")
     for e, m, sub, tin in NARROW:
         ar = make_arith(f"e{e}m{m}", sub, tin)
         x = _boundaries(ar.format)

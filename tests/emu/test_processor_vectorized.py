@@ -354,7 +354,7 @@ def test_pairs_back_to_back_decode_alike_on_both_instruction_sets(instruction_se
     and with the AVX2 blocks."""
     from rend3r.emu import native
 
-    if instruction_set == "avx2" and native.isa() != "avx2":
+    if not native.runs(instruction_set):
         pytest.skip("this processor has no AVX2")
     import rend3r.emu.processor as processor
 

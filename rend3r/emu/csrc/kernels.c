@@ -36,6 +36,19 @@ int32_t have_avx2(void)
 #endif
 }
 
+/* Whether this processor runs the AVX-512 build of the kernels (the _avx512 files of
+ * instances/: the AVX2 build's code with AVX-512 F, VL, BW and DQ instructions; libgcc's
+ * check also asks whether the system saves the AVX-512 registers). */
+int32_t have_avx512(void)
+{
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+    return have_avx2() && __builtin_cpu_supports("avx512f") != 0 && __builtin_cpu_supports("avx512vl") != 0
+           && __builtin_cpu_supports("avx512bw") != 0 && __builtin_cpu_supports("avx512dq") != 0;
+#else
+    return 0;
+#endif
+}
+
 /* ---- the shape hierarchy (rend3r/emu/bvh.py, csrc/bvh.h) ---- */
 
 /* A shape while the hierarchy is built: its centre in float (the tree's shape decides only

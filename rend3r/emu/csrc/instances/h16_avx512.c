@@ -1,0 +1,11 @@
+/* The fp16 (subnormals flushed) kernels for AVX-512 (instances.inc), which native.py uses where
+ * have_avx512() says the processor runs them (AVX2, F16C and AVX-512 F, VL, BW and DQ): the
+ * AVX2 kernels' eight-lane code, whose compares, selects and conversions the compiler then
+ * writes with the AVX-512 mask registers and three-operand logic; the same IEEE operations
+ * lane by lane (no FMA: -ffp-contract=off). */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#pragma GCC target("avx2,f16c,avx512f,avx512vl,avx512bw,avx512dq")
+#define KERNELS_H16
+#define ISA avx512
+#include "../instances.inc"
+#endif

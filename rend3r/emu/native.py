@@ -238,10 +238,28 @@ def library() -> ctypes.CDLL:
     return lib
 
 
-@lru_cache(maxsize=1)
 def isa() -> str:
-    """The instruction set the kernels run in, of INSTRUCTION_SETS: the last one the processor
-    runs, up to ``REND3R_ISA`` if set (the same values in every one)."""
+    """The instruction set the kernels run in, of INSTRUCTION_SETS: the one :func:`choose`
+    set, else the last one the processor runs, up to ``REND3R_ISA`` if set (the same values
+    in every one)."""
+    return _chosen or _best()
+
+
+_chosen: str | None = None
+
+
+def choose(instruction_set: str | None) -> None:
+    """Run the kernels of ``instruction_set`` from now on, in every thread (None: the one
+    :func:`isa` picks by itself); for benchmarks and tests that compare the builds.
+    ValueError when this build or processor does not run it."""
+    global _chosen
+    if instruction_set is not None and (instruction_set not in INSTRUCTION_SETS or not runs(instruction_set)):
+        raise ValueError(f"this processor does not run the {instruction_set!r} kernels")
+    _chosen = instruction_set
+
+
+@lru_cache(maxsize=1)
+def _best() -> str:
     wanted = os.environ.get("REND3R_ISA") or INSTRUCTION_SETS[-1]
     if wanted not in INSTRUCTION_SETS:
         raise Rend3rError(f"REND3R_ISA={wanted!r}: choose one of {', '.join(INSTRUCTION_SETS)}")

@@ -314,17 +314,17 @@ def test_every_instruction_set_renders_alike(cam, lights, shapes, ties, prec, wa
     options = EmuOptions(precision=prec[0], subnormals=prec[1], width=24, height=18)
     if wall:
         cam, shapes = _columns(3, 3, 0.5, 6, (1.0, 1.0, 1.0), shapes[0]["rot"], 0.15)
-    scene, chosen = scene_of(program(cam, lights, shapes, ties, options), options), native.isa
+    scene = scene_of(program(cam, lights, shapes, ties, options), options)
     try:
         renders, tables = [], []
         for name in sets:
-            native.isa = lambda name=name: name
+            native.choose(name)
             renders.append(render_frame(scene, options))
             fr = raytracer.set_up(scene, options)
             primary = () if fr.primary is None else (fr.primary[0].box, *fr.primary[1:])
             tables.append([np.array(a) for a in (fr.sf, fr.si, fr.bnd, *primary)])
     finally:
-        native.isa = chosen
+        native.choose(None)
     (first, counts), rest = renders[0], renders[1:]
     for frame, other in rest:
         assert_same(first, frame)

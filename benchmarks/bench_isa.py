@@ -7,7 +7,8 @@ the same build; a build's figure is the median of its times, and its ratio to th
 baseline build (the first given) the median over rounds of the pair in that round, so
 that the machine's drift falls on both. The frames of every build are compared (pixels,
 depth, provenance and counts): the builds differ in speed only.
-Exit status 0, or 1 when a build's frame differs from the baseline's (a bug).
+Exit status 0; 1 when a build's frame differs from the baseline's (a bug); 2 when this
+processor runs fewer than two of the builds asked for.
 
     python benchmarks/bench_isa.py [--sizes 1 16 256 4096 65536] [--precisions fp32 fp16]
                                    [--isas avx2 avx512] [--rounds 40] [--cpu 0]
@@ -81,6 +82,8 @@ def main() -> int:
     args = parser.parse_args()
     if args.rounds < 1:
         parser.error("--rounds must be at least 1")
+    if args.isas is not None and len(set(args.isas)) != len(args.isas):
+        parser.error(f"--isas {' '.join(args.isas)}: name each build once")
     if args.cpu not in os.sched_getaffinity(0):
         parser.error(f"--cpu {args.cpu}: this process may use CPUs {sorted(os.sched_getaffinity(0))}")
     isas = args.isas or [isa for isa in ("avx2", "avx512") if native.runs(isa)]

@@ -195,6 +195,10 @@ def emulate_command(program, output, frames, mode, precision, stage_precision, s
                    f"that cannot change a pixel, overflowing ones included); see --stats", err=True)
     if show_stats:
         click.echo(result.stats.report())
+        if options.mode != "raster":  # the rasterizer is numpy; the raytracer's kernels come in builds
+            from . import native
+
+            click.echo(f"kernels: the {native.isa()} build (REND3R_ISA=base or avx2 caps it)")
 
 
 @contextmanager

@@ -182,7 +182,7 @@ def _fits(have: tuple[int, ...], shape: tuple[int | None, ...]) -> bool:
 
 
 #: The kernels' builds, each instruction set also running the ones before it: portable, AVX2
-#: (with F16C), AVX-512 (F, VL, BW and DQ, on the AVX2 build's eight lanes).
+#: (with F16C), AVX-512 (F, VL, BW and DQ, on the AVX2 build's 256-bit vectors).
 INSTRUCTION_SETS = ("base", "avx2", "avx512")
 #: Kernel suffix per (precision, flush subnormals); narrow formats' kernels are NARROW's (float
 #: lanes, csrc/fnarrow.h), every other format's FORMAT's (double lanes, csrc/fformat.h).
@@ -249,12 +249,15 @@ _chosen: str | None = None
 
 
 def choose(instruction_set: str | None) -> None:
-    """Run the kernels of ``instruction_set`` from now on, in every thread (None: the one
-    :func:`isa` picks by itself); for benchmarks and tests that compare the builds.
-    ValueError when this build or processor does not run it."""
+    """Run the kernels of ``instruction_set`` from now on, in every thread, whatever
+    ``REND3R_ISA`` says (None: the one :func:`isa` picks by itself); for benchmarks and
+    tests that compare the builds. ValueError when it is not one of INSTRUCTION_SETS or
+    this build or processor does not run it."""
     global _chosen
-    if instruction_set is not None and (instruction_set not in INSTRUCTION_SETS or not runs(instruction_set)):
-        raise ValueError(f"this processor does not run the {instruction_set!r} kernels")
+    if instruction_set is not None and instruction_set not in INSTRUCTION_SETS:
+        raise ValueError(f"no {instruction_set!r} build of the kernels: choose one of {', '.join(INSTRUCTION_SETS)}")
+    if instruction_set is not None and not runs(instruction_set):
+        raise ValueError(f"this processor does not run the {instruction_set} build of the kernels")
     _chosen = instruction_set
 
 

@@ -77,6 +77,9 @@ def test_apng_depth_png_and_stats(tmp_path, src):
              tmp_path / "p.npy", "--stats", "--size", "32x24", "--precision", "fp32")
     assert r.exit_code == 0, r.output
     assert "device estimate" in r.output and "rays 768" in r.output
+    from rend3r.emu import native
+
+    assert f"kernels: the {native.isa()} build" in r.output
     d = np.asarray(Image.open(tmp_path / "d.png"))
     assert d.dtype.kind in "iu" and d.max() == 65535 and d.min() == 0
     prov = np.load(tmp_path / "p.npy")

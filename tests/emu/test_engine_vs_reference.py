@@ -319,6 +319,7 @@ def test_every_instruction_set_renders_alike(cam, lights, shapes, ties, prec, wa
         renders, tables = [], []
         for name in sets:
             native.choose(name)
+            assert native.kernel("nearest", options.arith).__name__.endswith(f"_{name}")  # the build in use
             renders.append(render_frame(scene, options))
             fr = raytracer.set_up(scene, options)
             primary = () if fr.primary is None else (fr.primary[0].box, *fr.primary[1:])

@@ -4,8 +4,9 @@
  * multiply-adds, no fast-math, IEEE subnormals (setup.py passes -ffp-contract=off).
  * The datapath is written once (datapath.inc) and instantiated per working precision
  * and instruction set in instances/: _f32 (fp32), _h16 (fp16, subnormals flushed), _h16i
- * (fp16, IEEE subnormals), _f64 (fp64), each _base and _avx2. This file holds the rest:
- * the shape hierarchy, shadow grids and bounds, in double.
+ * (fp16, IEEE subnormals), _f64 (fp64), _nar and _fmt (other formats), each _base,
+ * _avx2 and _avx512. This file holds the rest: the shape hierarchy, shadow grids and
+ * bounds, in double (the shape passes in a _base and an _avx2 copy, shape_bounds.inc).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>

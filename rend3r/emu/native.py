@@ -265,7 +265,8 @@ def choose(instruction_set: str | None) -> None:
 def _best() -> str:
     wanted = os.environ.get("REND3R_ISA") or INSTRUCTION_SETS[-1]
     if wanted not in INSTRUCTION_SETS:
-        raise Rend3rError(f"REND3R_ISA={wanted!r}: choose one of {', '.join(INSTRUCTION_SETS)}")
+        shown = repr(wanted) if len(wanted) <= 40 else f"{wanted[:40]!r}... ({len(wanted):,} characters)"
+        raise Rend3rError(f"REND3R_ISA={shown}: choose one of {', '.join(INSTRUCTION_SETS)}")
     return next(s for s in reversed(INSTRUCTION_SETS[:INSTRUCTION_SETS.index(wanted) + 1]) if runs(s))
 
 

@@ -50,6 +50,13 @@ def test_an_unknown_rend3r_isa_names_the_choices(fresh_choice, monkeypatch):
         native.isa()
 
 
+def test_a_long_rend3r_isa_is_shown_cut(fresh_choice, monkeypatch):
+    monkeypatch.setenv("REND3R_ISA", "x" * 5000)
+    with pytest.raises(Rend3rError, match=r"REND3R_ISA='x{40}'\.\.\. \(5,000 characters\): choose one of") as e:
+        native.isa()
+    assert len(str(e.value)) < 200
+
+
 def test_choose_sets_the_build_until_it_is_cleared(fresh_choice):
     picked = native.isa()
     native.choose("base")

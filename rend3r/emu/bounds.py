@@ -19,6 +19,7 @@ import numpy as np
 
 from . import native
 from .native import address
+from .workspace import empty
 
 #: Shapes or items a range of a set-up pass takes at least (csrc/setup.c): the passes take
 #: about 30 ns a shape, and a team of threads hands a range over in about a microsecond.
@@ -49,8 +50,8 @@ def primary(table: np.ndarray, ok: np.ndarray, apex: np.ndarray, dmin: float, dm
     (``csrc/kernels.h`` PC_COLUMNS); ``u``, ``tiny`` and ``overflow`` are the precision's
     unit roundoff, smallest normal and overflow threshold."""
     n = len(table)
-    p = shape_pass(table, ok, u, tiny, overflow, native.PASS_PRIMARY, floor=np.empty(n),
-                   pc=np.empty((n, native.PC_COLUMNS)))
+    p = shape_pass(table, ok, u, tiny, overflow, native.PASS_PRIMARY, floor=empty(n),
+                   pc=empty((n, native.PC_COLUMNS)))
     p.block.apex[:] = [float(c) for c in apex]
     p.block.dmin, p.block.dmax = dmin, dmax
     p.block.floor, p.block.pc = address(p.floor), address(p.pc)
@@ -65,7 +66,7 @@ def shape_pass(table: np.ndarray, ok: np.ndarray, u: float, tiny: float, overflo
     native.ptr(table, np.float64, (n, native.B_COLUMNS))
     flags = np.ascontiguousarray(ok, np.uint8)
     native.ptr(flags, np.uint8, (n,))
-    p = Pass(native.Bundle(), table, flags, np.empty(n), **arrays)
+    p = Pass(native.Bundle(), table, flags, empty(n), **arrays)
     b = p.block
     b.bnd, b.ok, b.n, b.radius, b.pass_ = address(table), address(flags), n, address(p.radius), kind
     b.u, b.tiny, b.overflow = u, tiny, overflow

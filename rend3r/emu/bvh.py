@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import Rend3rError
 from . import bounds as shape_bounds, native, threads
 from .native import address
+from .workspace import empty
 
 
 @dataclass(frozen=True)
@@ -88,9 +88,9 @@ class Tree:
         frame = np.zeros(6)
         frame[: 3 if apex is not None else 6] = np.ravel(apex if apex is not None else axes)
         # each shape's own cone (a scratch array) or box (kept: shadow packets test it), then the nodes'
-        own = np.empty((len(self.items), native.CI_COLUMNS if apex is not None else native.BX_COLUMNS))
-        bounds = Bounds(self, np.empty((nodes, native.BV_COLUMNS)), frame, own if axes is not None else None,
-                        None if not keys else np.empty((nodes, 3 if axes is not None else native.PK_COLUMNS)))
+        own = empty((len(self.items), native.CI_COLUMNS if apex is not None else native.BX_COLUMNS))
+        bounds = Bounds(self, empty((nodes, native.BV_COLUMNS)), frame, own if axes is not None else None,
+                        None if not keys else empty((nodes, 3 if axes is not None else native.PK_COLUMNS)))
         block.kind, block.tree, block.items = kind, bounds.view, len(self.items)
         block.box, block.own = address(bounds.box), address(own)
         block.node_keys = None if bounds.keys is None else address(bounds.keys)
@@ -128,9 +128,7 @@ def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
     ok = np.ascontiguousarray(bounded, np.uint8)  # 0 or 1 (bool or uint8 given)
     native.ptr(ok, np.uint8, (n,))
     items, always, node = np.empty(n, np.int32), np.empty(n, np.int32), np.empty((max(1, 2 * n), 2), np.int32)
-    counts = np.zeros(2, np.int64)
+    counts, room = np.zeros(2, np.int64), empty(n * native.BUILD_BYTES // 8, np.uint64)
     nodes = native.library().bvh_build(address(bnd), address(ok), n, address(items), address(always), address(node),
-                                       address(counts))
-    if nodes < 0:
-        raise Rend3rError(f"not enough memory to build the shape hierarchy of {n:,} shapes")
+                                       address(counts), address(room))
     return Tree(node[:nodes], items[:counts[0]], always[:counts[1]])

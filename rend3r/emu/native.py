@@ -37,6 +37,7 @@ OUT_TESTS, OUT_NAN_TESTS, OUT_SHADOW_RAYS, OUT_HITS, OUT_LO, OUT_HI = 0, 1, 2, 3
 OUT_SHOWN, OUT_NAN_RAYS, OUT_COLUMNS = 10, 11, 12
 PC_COLUMNS = 14
 BVH_CONE, BVH_FLAT = 0, 1  # a hierarchy's bounds around lines through one apex, or parallel lines
+BUILD_BYTES = 48  # bvh_build's working room a shape
 BV_SINE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 5, 6, 12  # their columns (csrc/kernels.h)
 BX_COLUMNS = 8  # a shape's own box on the axes normal to parallel lines (and rounded to floats)
 CI_COLUMNS = 5  # a shape's own cone around an apex: unit axis, sine and cosine of its half-angle
@@ -112,7 +113,7 @@ class Setup(Structure):
                 ("kinds", c_void_p), ("cam", c_void_p), ("tiny", c_double), ("format", POINTER(Format)),
                 ("sf", c_void_p), ("sf_row", c_int64), ("si", c_void_p), ("bnd", c_void_p), ("bounded", c_void_p),
                 ("index_out", c_void_p), ("items", c_void_p), ("always", c_void_p), ("node", c_void_p),
-                ("counts", c_int64 * 2), ("nodes", c_int64), ("shapes", c_int64), ("jobs", c_int32),
+                ("room", c_void_p), ("counts", c_int64 * 2), ("nodes", c_int64), ("shapes", c_int64), ("jobs", c_int32),
                 ("chunk", c_int64)]
 
 
@@ -143,7 +144,8 @@ class Bands(Structure):
                 ("light_row", c_int64), ("lights", c_int64), ("light_frames", c_void_p), ("scales", c_void_p),
                 ("fixed", c_int32), ("item", c_int32), ("bounded", c_void_p), ("items", c_int64),
                 ("overflow", c_double), ("jobs", c_int32), ("avx2", c_int32), ("chunk", c_int64),
-                ("min_chunk", c_int64), ("chunks_per_job", c_int64), ("counts", c_int64 * BC_COLUMNS)]
+                ("min_chunk", c_int64), ("chunks_per_job", c_int64), ("counts", c_int64 * BC_COLUMNS),
+                ("memory", c_void_p), ("memory_bytes", c_int64)]
 
 
 #: Pixels a band may hold and the widest frame, for Band.row_magic (csrc/kernels.h band_row).
@@ -200,7 +202,7 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
                               c_void_p, c_void_p, c_void_p]),
 }
 _PLAIN = {
-    "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
+    "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p]),
     "have_avx2": (c_int32, []),
     "have_avx512": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
@@ -214,6 +216,7 @@ _PLAIN = {
     "team_close": (None, [c_void_p]),
     "frame_setup": (c_int64, [POINTER(Setup), POINTER(Bundle), c_void_p]),
     "bundle_bounds": (None, [POINTER(Bundle), c_void_p]),
+    "band_bytes": (c_int64, [POINTER(Bands), c_int64]),
     "render_band": (c_int64, [POINTER(Bands), c_int64, c_int64, c_void_p, c_void_p, c_void_p, c_void_p]),
 }
 @lru_cache(maxsize=1)

@@ -36,6 +36,7 @@ from . import native, threads
 from .native import address
 from .options import EmuOptions
 from .scene import ObjectTable, Scene
+from .workspace import empty
 
 #: Called at each ``nf`` with the scene and the frame number (0-based).
 RenderHook = Callable[[Scene, int], None]
@@ -122,7 +123,7 @@ class _Stream:
     def __init__(self, prog: _Program, start: int) -> None:
         self.prog, self.start = prog, start
         room = max(0, len(prog.words) - start)
-        lists, count = np.empty((_LISTS, room), np.int64), np.zeros(_LISTS, np.int64)
+        lists, count = empty((_LISTS, room), np.int64), np.zeros(_LISTS, np.int64)
         at = address(lists) + lists.strides[0] * np.arange(_LISTS, dtype=np.int64)
         native.library().stream_scan(address(prog.words), len(prog.words), start, OPCODE.lo, OPCODE.width, FUNC.lo,
                                      address(_KIND), address(at), address(count))
@@ -264,7 +265,7 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
     ranges of pairs on a team of ``jobs`` threads when there are many), then over the
     decoded pairs the writes, in order (threads that each took a range of rows spent
     nearly as long reading every pair as one thread writing them all)."""
-    records = np.empty(len(at), np.uint64)  # each pair decoded once, by pair_marks for pair_apply
+    records = empty(len(at), np.uint64)  # each pair decoded once, by pair_marks for pair_apply
     pairs = native.Pairs(address(words), len(words), address(at), len(at), address(_PAIR_FIELDS),
                          None if tables is None else address(tables), entry, address(wanted), address(_SE_NULL),
                          address(records), native.avx2())

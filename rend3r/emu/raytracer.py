@@ -46,6 +46,7 @@ from .lights import POINT, Light, lights_from_scene, lights_key
 from .options import EmuOptions
 from .scene import Scene, prop_index
 from .stats import FrameStats
+from .workspace import empty
 
 Progress = Callable[[float], None]
 #: Pixels per band at most: bounds the per-pixel working arrays (about 100 bytes per pixel).
@@ -99,13 +100,14 @@ def render_frame(scene: Scene, options: EmuOptions, number: int = 0,
         if not len(fr.sf):  # else every band's finish pass sets every pixel
             rgb[:], depth[:], prov[:] = options.background, np.inf, -1
         else:
-            bands, _arrays = _bands(fr, options)  # _arrays: what the block points into
             rows, at = _band_rows(fr, w), (address(rgb), address(depth), address(prov))
+            bands, _arrays = _bands(fr, options, min(rows, h))  # _arrays: what the block points into
             for row0 in range(0, h, rows):
                 row1 = min(h, row0 + rows)
                 if native.library().render_band(byref(bands), row0, row1, at[0] + 2 * row0 * w,
                                                  at[1] + 4 * row0 * w, at[2] + 4 * row0 * w, team) < 0:
-                    raise Rend3rError(f"not enough memory to render rows {row0}..{row1} of a {w}x{h} frame")
+                    raise Rend3rError(f"rows {row0}..{row1} of a {w}x{h} frame need more working memory than "
+                                      f"its bands were given ({bands.memory_bytes:,} bytes)")
                 if progress is not None:
                     progress(row1 / h)
             for name, count in zip(_BAND_COUNTS, bands.counts):
@@ -226,13 +228,14 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
     s = native.Setup(native.kernel_address("shape_tables", ar),
                      native.ptr(values, np.uint16, (rows, PROP_LIMIT)), address(index), rows, address(_SHAPE_PROPS),
                      address(_KINDS), native.ptr(cam, dtype, (native.CAM_COLUMNS,)), ar.tiny, fmt)
-    sf = np.empty((rows, native.SF_COLUMNS), dtype)  # frame_setup fills them
-    si, bnd = np.empty((rows, native.SI_COLUMNS), np.int64), np.empty((rows, native.B_COLUMNS))
-    bounded, out = np.empty(rows, np.uint8), np.empty(rows, np.int32)
+    sf = empty((rows, native.SF_COLUMNS), dtype)  # frame_setup fills them
+    si, bnd = empty((rows, native.SI_COLUMNS), np.int64), empty((rows, native.B_COLUMNS))
+    bounded, out = empty(rows, np.uint8), empty(rows, np.int32)
     s.sf, s.sf_row, s.si, s.bnd, s.bounded, s.index_out = (address(sf), sf.strides[0], address(si), address(bnd),
                                                            address(bounded), address(out))
-    room = bvh.Tree(np.empty((max(1, 2 * rows), 2), np.int32), np.empty(rows, np.int32), np.empty(rows, np.int32))
-    s.node, s.items, s.always = address(room.node), address(room.items), address(room.always)
+    room = bvh.Tree(empty((max(1, 2 * rows), 2), np.int32), empty(rows, np.int32), empty(rows, np.int32))
+    build = empty(rows * native.BUILD_BYTES // 8, np.uint64)  # the build's working copies
+    s.node, s.items, s.always, s.room = address(room.node), address(room.items), address(room.always), address(build)
     s.jobs, s.chunk = jobs, bounds.SHAPE_CHUNK
     first = None
     if extent is not None:  # the primary bounds in the same call, around the camera origin
@@ -241,8 +244,6 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
         fitted, own = room.bounds_for(first.block, apex, None, room.nodes, False, jobs)  # own: the call's scratch
     with threads.team(jobs) as team:
         n = native.library().frame_setup(byref(s), None if first is None else byref(first.block), team)
-    if n < 0:
-        raise Rend3rError(f"not enough memory to build the shape hierarchy of {rows:,} shapes")
     tree = bvh.Tree(room.node[:s.nodes], room.items[:s.counts[0]], room.always[:s.counts[1]])
     primary = None if first is None else \
         (bvh.Bounds(tree, fitted.box[:s.nodes], fitted.frame), first.floor[:n], first.pc[:n])
@@ -297,9 +298,10 @@ def _scales(lights: list[Light]) -> np.ndarray:
     return np.array([[((lt.color >> shift) & top) / top for shift, top in _CHANNELS] for lt in lights]).reshape(-1, 3)
 
 
-def _bands(fr: _Frame, options: EmuOptions) -> tuple[native.Bands, list]:
-    """The block csrc/band.c render_band renders each band of the frame with, and the
-    arrays it points into (they must outlive it)."""
+def _bands(fr: _Frame, options: EmuOptions, rows: int) -> tuple[native.Bands, list]:
+    """The block csrc/band.c render_band renders each band of the frame with (bands of
+    ``rows`` rows at most, and their working memory), and the arrays it points into (they
+    must outlive it)."""
     band, keep = _band_block(fr, options), []
     primary = fr.primary
     b = native.Bands(pointer(band))
@@ -322,6 +324,10 @@ def _bands(fr: _Frame, options: EmuOptions) -> tuple[native.Bands, list]:
         len(fr.tree.items)
     b.overflow, b.jobs, b.avx2, b.chunk = fr.ar.overflow, fr.jobs, native.avx2(), bounds.SHAPE_CHUNK
     b.min_chunk, b.chunks_per_job = MIN_CHUNK, CHUNKS_PER_JOB
+    b.memory_bytes = native.library().band_bytes(byref(b), rows * options.width)
+    memory = empty(b.memory_bytes, np.uint8)
+    b.memory = address(memory)
+    keep.append(memory)
     return b, keep
 
 

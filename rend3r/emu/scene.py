@@ -16,6 +16,7 @@ import numpy as np
 
 from ..isa import Table, lookup
 from ..isa.tables import PROP_LIMIT, SHAPE_INDEX_LIMIT
+from .workspace import empty
 
 
 @lru_cache(maxsize=256)
@@ -58,10 +59,11 @@ class ObjectTable:
         if had:
             top = max(top, int(self.index[-1]) + 1)
             mark[self.index] = 1
-        row_of, merged = np.empty(top, np.int32), np.empty(top, np.int64)
+        row_of, merged = empty(top, np.int32), empty(top, np.int64)
         merged = merged[:library().mark_rows(address(mark), top, address(row_of), address(merged))]
         if len(merged) > had:
-            values = np.zeros((len(merged), PROP_LIMIT), dtype=np.uint16)
+            values = empty((len(merged), PROP_LIMIT), np.uint16)
+            values.view(np.uint64).fill(0)  # kept memory (workspace.py), zeroed 8 bytes at a time
             if had:
                 values[row_of[self.index]] = self.values
             self.index, self.values = merged, values

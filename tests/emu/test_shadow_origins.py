@@ -47,7 +47,7 @@ def _band_after_nearest(fr, options: EmuOptions) -> tuple[native.Band, list]:
     """The frame's one band with its nearest hits (the nearest-hit kernel over every row),
     and the arrays it points into."""
     n_pix, dtype = options.pixels, fr.dtype
-    bands, keep = raytracer._bands(fr, options)
+    bands, keep = raytracer._bands(fr, options, options.height)
     band = bands.band.contents
     arrays = {"slot": np.empty(n_pix, np.int32), "sqd": np.empty(n_pix, dtype), "pt": np.empty((3, n_pix), dtype),
               "nm": np.empty((3, n_pix), dtype), "bad": np.empty(n_pix, np.uint8), "nan_px": np.empty(n_pix, np.uint8),

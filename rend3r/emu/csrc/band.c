@@ -117,7 +117,7 @@ static void *carve(char *base, size_t *at, size_t size)
 static size_t lay_out(Bands *f, Work *w, char *base, int64_t npix)
 {
     Band *b = f->band;
-    int64_t n = b->sh->n, kept = f->lights > 0 && b->in_pass == NULL ? npix : 0, item = f->item;
+    int64_t n = b->sh->n, kept = f->lights > 0 && n != 1 ? npix : 0, item = f->item;  /* none: in_pass */
     size_t at = sizeof(double) * ROW;  /* a row's room before the report rows and after them: no other array on
                                            their lines or the lines fetched with them */
     w->capacity = f->chunks_per_job * (f->jobs > 1 ? f->jobs : 1);
@@ -276,19 +276,27 @@ static void light(Bands *f, Team *team, Work *w, int64_t k, const double *hits, 
 
 /* ---- the band ---- */
 
+/* The working memory render_band takes for a band of npix pixels of the frame f. */
+int64_t band_bytes(Bands *f, int64_t npix)
+{
+    Work w;
+    return (int64_t)lay_out(f, &w, NULL, npix) + LINE;
+}
+
 /* Rows row0..row1 of the frame f (at most 2**20 pixels: band_row) rendered into rgb,
- * depth and prov (the band's pixels), adding the band's counts to f->counts. Returns 0,
- * or -1 when its working memory could not be allocated (nothing is then drawn). */
+ * depth and prov (the band's pixels) with f->memory, adding the band's counts to
+ * f->counts. Returns 0, or -1 when f->memory_bytes is less than band_bytes (nothing is
+ * then drawn). */
 int64_t render_band(Bands *f, int64_t row0, int64_t row1, uint16_t *rgb, float *depth, int32_t *prov, Team *team)
 {
     Band *b = f->band;
-    int64_t n = b->sh->n, npix = (row1 - row0) * b->width;
+    int64_t npix = (row1 - row0) * b->width;
+    if (f->memory == NULL || f->memory_bytes < band_bytes(f, npix))
+        return -1;
+    int64_t n = b->sh->n;
     b->in_pass = f->lights > 0 && n == 1 ? f : NULL;  /* one shape casts no shadow: its lights need no pass */
     Work w;
-    char *memory = malloc(lay_out(f, &w, NULL, npix) + LINE);
-    if (memory == NULL)
-        return -1;
-    lay_out(f, &w, memory + (LINE - (uintptr_t)memory % LINE) % LINE, npix);
+    lay_out(f, &w, f->memory + (LINE - (uintptr_t)f->memory % LINE) % LINE, npix);
     b->row0 = row0;
     b->npix = npix;
     b->rgb = rgb;
@@ -316,8 +324,7 @@ int64_t render_band(Bands *f, int64_t row0, int64_t row1, uint16_t *rgb, float *
     }
     f->counts[BC_HITS] += (int64_t)done[OUT_SHOWN];
     f->counts[BC_NAN_RAYS] += (int64_t)done[OUT_NAN_RAYS];
-    free(memory);
-    b->slot = NULL;  /* the band's arrays are gone */
+    b->slot = NULL;  /* the band's arrays are the next band's */
     b->sqd = b->pt = b->nm = b->dirs = NULL;
     b->bad = b->nan_px = NULL;
     b->acc = NULL;

@@ -58,6 +58,7 @@ int32_t have_avx512(void)
  * how fast rays find their shapes, never what they hit) and its slot, packed so that the
  * splits walk one small array instead of following slots into the bound table. */
 typedef struct { float c[3]; int32_t slot; } BuildItem;
+_Static_assert(2 * sizeof(BuildItem) + 2 * sizeof(uint64_t) == BUILD_BYTES, "bvh_build's room a shape");
 
 /* Reorders a[lo..hi) so that a[k] has the centre coordinate `axis` that sorting would give
  * it, none before it larger and none after it smaller (quickselect). */
@@ -152,22 +153,17 @@ static uint64_t *radix_sort(uint64_t *key, uint64_t *tmp, int64_t n)
  * are split across the longest side of their centres' box (quickselect) at the median
  * rounded up to whole leaves.
  * Leaves hold at most BVH_LEAF shapes. items is ordered leaf by leaf; node (2 ints per
- * node, room for 2n nodes) gets the nodes depth first. Returns the node count, or -1 when
- * the working copies cannot be allocated. */
+ * node, room for 2n nodes) gets the nodes depth first; room (rows x BUILD_BYTES, 8-byte
+ * aligned) holds the working copies. Returns the node count. */
 int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
-                  int32_t *node, int64_t *count_out)
+                  int32_t *node, int64_t *count_out, void *room)
 {
     int64_t stack[4 * BVH_STACK], top = 1, count = 0, n = 0, outside = 0;
     count_out[0] = count_out[1] = 0;
     if (rows <= 0)
         return 0;
-    BuildItem *a = malloc((size_t)rows * 2 * sizeof *a);  /* the shapes, then in Morton order */
-    uint64_t *keys = malloc((size_t)rows * 2 * sizeof *keys);
-    if (a == NULL || keys == NULL) {
-        free(a);
-        free(keys);
-        return -1;
-    }
+    uint64_t *keys = room;  /* 2 rows keys, then the shapes twice: as given, then in Morton order */
+    BuildItem *a = (BuildItem *)(keys + 2 * rows);
     float lo3[3] = {INFINITY, INFINITY, INFINITY}, hi3[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int64_t s = 0; s < rows; s++) {
         const double *c = bnd + B_COLUMNS * s;
@@ -181,11 +177,8 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     }
     count_out[0] = n;
     count_out[1] = outside;
-    if (n == 0) {
-        free(a);
-        free(keys);
+    if (n == 0)
         return 0;
-    }
     double side = MAX(MAX((double)hi3[0] - lo3[0], (double)hi3[1] - lo3[1]), (double)hi3[2] - lo3[2]);
     double scale = side > 0 && side < INFINITY ? (double)(1 << MORTON_BITS) / side : 0.0;  /* else one code */
     for (int64_t i = 0; i < n; i++) {
@@ -247,8 +240,6 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     }
     for (int64_t i = 0; i < n; i++)
         items[i] = a[i].slot;
-    free(a - n);
-    free(keys);
     return count;
 }
 

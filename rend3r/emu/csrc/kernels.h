@@ -71,6 +71,8 @@ typedef struct {
  * widened squared sine of the float test (bvh.h cone_missed8), a box its bounds rounded
  * outwards to floats. */
 enum { BVH_CONE = 0, BVH_FLAT = 1 };
+/* Bytes a shape of bvh_build's working room: its Morton key twice, its centre and slot twice. */
+enum { BUILD_BYTES = 48 };
 enum { BV_AXIS = 0, BV_SINE = 3, BV_COS = 4, BV_SIN2 = 5, BV_U0 = 0, BV_U1 = 1, BV_V0 = 2, BV_V1 = 3,
        BV_FLOOR = 6, BV_FLOOR32 = 7, BV_AXIS32 = 8, BV_SIN2_32 = 11, BV_BOX32 = 8, BV_COLUMNS = 12 };
 /* Parallel lines also get each shape's own box (BV_U0..BV_V1), per item in leaf order;
@@ -179,6 +181,7 @@ typedef struct {            /* a frame's set-up (setup.c frame_setup) */
     uint8_t *bounded;
     int32_t *index_out;
     int32_t *items, *always, *node; /* out, room for rows, rows and max(1, 2 rows) nodes: the tree */
+    void *room;             /* rows x BUILD_BYTES, 8-byte aligned: the build's working copies */
     int64_t counts[2];      /* out: the tree's items and the shapes outside it */
     int64_t nodes;          /* out: its nodes */
     int64_t shapes;         /* out: the shapes on */
@@ -244,6 +247,8 @@ typedef struct Bands {      /* a frame's bands, each rendered in one call (band.
     int64_t chunk;          /* shapes or items a range takes at least */
     int64_t min_chunk, chunks_per_job; /* pixels a chunk takes at least; the most chunks a thread takes */
     int64_t counts[BC_COLUMNS]; /* out: summed over the bands */
+    char *memory;           /* the bands' working memory (band_bytes for the largest band) */
+    int64_t memory_bytes;
 } Bands;
 
 /* The row within its band of pixel p: (p * row_magic) >> 40 equals p / width exactly for

@@ -42,7 +42,7 @@ SHAPE_PASSES(avx2)
 #endif
 
 int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
-                  int32_t *node, int64_t *count_out);
+                  int32_t *node, int64_t *count_out, void *room);
 void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items, const double *keys,
                double *node_keys, int64_t lo, int64_t hi);
 
@@ -186,7 +186,7 @@ static void build_task(void *ctx, int64_t k)
     Tables *t = ctx;
     Setup *s = t->s;
     if (k == 0)
-        s->nodes = bvh_build(s->bnd, s->bounded, s->shapes, s->items, s->always, s->node, s->counts);
+        s->nodes = bvh_build(s->bnd, s->bounded, s->shapes, s->items, s->always, s->node, s->counts, s->room);
     else
         shape_task(t->primary, k - 1);
 }
@@ -194,8 +194,7 @@ static void build_task(void *ctx, int64_t k)
 /* The shape tables of the object table's rows (datapath.inc shape_tables, in ranges of
  * rows, each range's shapes then moved up behind the previous range's), the tree over
  * them (kernels.c bvh_build) and, when primary is not NULL, the primary rays' bounds
- * (its shape pass beside the build, then bundle_tree). Returns the shapes on, or -1 when
- * the build could not allocate its working copies. */
+ * (its shape pass beside the build, then bundle_tree). Returns the shapes on. */
 int64_t frame_setup(Setup *s, Bundle *primary, Team *team)
 {
     Tables t = {.s = s, .primary = primary, .parts = shape_parts(s->rows, s->jobs, s->chunk)};
@@ -217,8 +216,6 @@ int64_t frame_setup(Setup *s, Bundle *primary, Team *team)
         primary->n = n;
     int64_t passes = primary != NULL ? shape_parts(n, primary->jobs, primary->chunk) : 0;
     team_phase(team, build_task, &t, 1 + passes);
-    if (s->nodes < 0)
-        return -1;
     if (primary != NULL) {
         primary->items = s->counts[0];
         primary->tree.nodes = s->nodes;

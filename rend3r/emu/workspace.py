@@ -26,7 +26,7 @@ from bisect import bisect_left
 import numpy as np
 
 #: Bytes below which an array is not worth a buffer.
-SMALLEST = 1 << 18
+SMALLEST = 1 << 16
 #: Buffers a thread keeps at most (more arrays alive at once come from np.empty).
 KEPT = 64
 #: A buffer made for an array gets this much more room, so that a scene that grows a

@@ -67,9 +67,10 @@ def test_each_thread_has_its_own_buffers() -> None:
 
 def test_repeated_frames_keep_their_memory_and_their_pixels() -> None:
     """A wall of 4,096 spheres rendered again and again (on a thread of its own, whose
-    buffers no other test touched): the kept bytes stop growing after the first run,
-    every frame is the same, and a frame kept from an earlier run is not touched by later
-    ones (frames never come from the buffers)."""
+    buffers no other test touched): the kept bytes stop growing after a few runs (a
+    buffer is only ever replaced by a larger one, up to the largest array asked for) and
+    stay within twice the first run's, every frame is the same, and a frame kept from an
+    earlier run is not touched by later ones (frames never come from the buffers)."""
     words = walls.wall(4096, lights=1).words
     options = EmuOptions(precision="fp32", width=96, height=64, jobs=1)
     kept: list[int] = []
@@ -78,7 +79,7 @@ def test_repeated_frames_keep_their_memory_and_their_pixels() -> None:
         first = run_program(words, options).frames[0]
         copy = first.rgb565.copy(), first.depth.copy(), first.provenance.copy()
         kept.append(workspace.kept_bytes())
-        for _ in range(3):
+        for _ in range(6):
             again = run_program(words, options).frames[0]
             assert (again.rgb565 == copy[0]).all() and (again.provenance == copy[2]).all()
             assert not np.shares_memory(again.rgb565, first.rgb565)
@@ -90,7 +91,7 @@ def test_repeated_frames_keep_their_memory_and_their_pixels() -> None:
     t.start()
     t.join()
     assert not errors, errors
-    assert kept[0] > 0 and kept == kept[:1] * 4, kept
+    assert 0 < kept[0] and kept[-1] == kept[-2] == kept[-3] <= 2 * kept[0], kept
 
 
 def _catching(fn, errors: list) -> None:

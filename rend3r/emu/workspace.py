@@ -2,8 +2,8 @@
 
 A frame's working arrays (the shape tables, the hierarchy, the bundles' bounds, the bands'
 per-pixel arrays) and the processor's instruction lists and tables grow with the scene
-(a 65,536-sphere run at 512x384 keeps buffers of 135 MB, 47 MB of it instruction lists
-whose pages are mostly never touched). Allocated afresh each time, glibc gives them back
+(a 65,536-sphere run at 512x384 keeps buffers of 115 MiB, 45 MiB of it instruction
+lists whose pages are mostly never touched). Allocated afresh each time, glibc gives them back
 to the kernel when they are freed (it trims the heap's top and unmaps large blocks), and
 the next run pays a page fault and a zeroed page for every 4 KiB it touches again: on
 this project's machine that was more than half of a 65,536-sphere run
@@ -13,7 +13,10 @@ it keeps, per thread, instead.
 A buffer is handed out again only once nothing refers to it: every array made from it
 holds it (numpy's ``base``), so an array that is kept, or a view of it, keeps its buffer
 out of use, and whatever lives on never shares memory with a later array. Arrays below
-``SMALLEST`` bytes come from ``np.empty`` (the heap serves them without faults).
+``SMALLEST`` bytes come from ``np.empty`` (the heap serves them without faults). A thread
+keeps its buffers as long as it lives: at most KEPT of them, about the working set of
+the largest frame it rendered (the worker threads of frames side by side end with their
+run; the main thread's stay for the next run).
 """
 
 from __future__ import annotations
@@ -32,14 +35,16 @@ KEPT = 64
 #: A buffer made for an array gets this much more room, so that a scene that grows a
 #: little from frame to frame does not make a new one each time.
 _SLACK = 1 / 8
+#: An array takes a free buffer at most this many times its size (a small array that
+#: lives long, a scene's table, would otherwise pin a frame's largest buffer).
+_LOOSEST = 2
 
 
 class _Buffers(threading.local):
-    """A thread's buffers (uint8), by size, and their sizes."""
+    """A thread's buffers (uint8), smallest first (one list: nothing to fall out of step)."""
 
     def __init__(self) -> None:
         self.kept: list[np.ndarray] = []
-        self.sizes: list[int] = []
 
 
 _buffers = _Buffers()
@@ -49,36 +54,45 @@ def _refs(buffers: list[np.ndarray], i: int) -> int:
     return sys.getrefcount(buffers[i])
 
 
-#: What _refs gives for a buffer that only the list holds (measured: the interpreter's own
-#: references depend on its version).
-_FREE = _refs([np.empty(0, np.uint8)], 0)
+def _calibrate() -> int | None:
+    """What _refs gives for a buffer that only the list holds (the interpreter's own
+    references depend on its version), checked against a buffer with a view alive; None
+    when they do not tell the two apart (then nothing is pooled)."""
+    kept = [np.empty(8, np.uint8)]
+    free = _refs(kept, 0)
+    view = kept[0][:4].view(np.int32)
+    held = _refs(kept, 0)
+    del view
+    return free if held > free and _refs(kept, 0) == free else None
+
+
+_FREE = _calibrate()
 
 
 def empty(shape: int | tuple[int, ...], dtype: np.dtype | type = np.float64) -> np.ndarray:
     """An uninitialized C-contiguous array, as ``np.empty(shape, dtype)`` gives, in the
     smallest free buffer of this thread that holds it (a new one when none does)."""
     dtype = np.dtype(dtype)
-    shape = (shape,) if isinstance(shape, int) else tuple(shape)
+    shape = (int(shape),) if isinstance(shape, (int, np.integer)) else tuple(int(n) for n in shape)
     need = math.prod(shape) * dtype.itemsize
-    if need < SMALLEST:
+    if need < SMALLEST or _FREE is None:
         return np.empty(shape, dtype)
-    b = _buffers
-    kept, sizes = b.kept, b.sizes
-    start = bisect_left(sizes, need)
-    found = next((i for i in range(start, len(kept)) if _refs(kept, i) == _FREE), -1)
+    kept = _buffers.kept
+    start = bisect_left(kept, need, key=len)
+    found = next((i for i in range(start, len(kept)) if len(kept[i]) <= _LOOSEST * need + SMALLEST
+                  and _refs(kept, i) == _FREE), -1)
     if found < 0:  # a new buffer, in place of the largest free one too small for it
         smaller = [i for i in range(start) if _refs(kept, i) == _FREE]
         if not smaller and len(kept) >= KEPT:
             return np.empty(shape, dtype)
+        buf = np.empty(need + int(need * _SLACK), np.uint8)
         if smaller:
-            del kept[smaller[-1]], sizes[smaller[-1]]
-        size = need + int(need * _SLACK)
-        found = bisect_left(sizes, size)
-        kept.insert(found, np.empty(size, np.uint8))
-        sizes.insert(found, size)
+            del kept[smaller[-1]]
+        found = bisect_left(kept, len(buf), key=len)
+        kept.insert(found, buf)
     return kept[found][:need].view(dtype).reshape(shape)
 
 
 def kept_bytes() -> int:
     """The bytes this thread's buffers hold."""
-    return sum(_buffers.sizes)
+    return sum(len(b) for b in _buffers.kept)

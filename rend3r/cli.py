@@ -66,6 +66,12 @@ class LazyGroup(click.Group):
         except Rend3rError as exc:
             click.echo(str(exc) if exc.preformatted else f"rend3r: error: {exc}", err=True)
             ctx.exit(exc.exit_code)
+        except MemoryError as exc:  # past what --max-memory estimated: the limit is the machine's
+            detail = f" ({exc})" if str(exc) else ""
+            click.echo(f"rend3r: error: out of memory{detail}: lower the work (pixels, frames, shapes) or free "
+                       "memory; --max-memory refuses such runs before they start when its estimate sees them",
+                       err=True)
+            ctx.exit(1)
         except KeyboardInterrupt:  # Ctrl-C: the run's outputs were never committed
             interrupted()
 

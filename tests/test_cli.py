@@ -2,6 +2,7 @@
 
 import subprocess
 import sys
+from pathlib import Path
 
 from click.testing import CliRunner
 
@@ -94,3 +95,26 @@ def test_exit_statuses_follow_one_convention(tmp_path):
     assert CliRunner().invoke(main, ["asm", str(tmp_path / "missing.asm")]).exit_code == 1
     assert CliRunner().invoke(main, ["asm", str(src), "--no-such-option"]).exit_code == 2
     assert CliRunner().invoke(main, ["no-such-command"]).exit_code == 2
+
+
+def test_running_out_of_memory_is_one_clear_error(tmp_path):
+    """A 65,536-sphere run in a process whose address space ends 64 MiB past what it has
+    after loading the command (the budget told to allow it): one error line, exit 1, no
+    traceback, no image."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    import walls
+
+    program = tmp_path / "wall.mem"
+    program.write_text("".join(f"{int(w):08x}\n" for w in walls.wall(65536, lights=1).words))
+    code = ("import resource, sys, numpy\n"
+            "from rend3r.cli import main\n"
+            "import rend3r.emu.cli, rend3r.emu.run, rend3r.emu.loader\n"
+            "size = int(open('/proc/self/statm').read().split()[0]) * resource.getpagesize()\n"
+            "resource.setrlimit(resource.RLIMIT_AS, (size + (64 << 20), resource.RLIM_INFINITY))\n"
+            "main(sys.argv[1:])\n")
+    out = tmp_path / "out.png"
+    run = subprocess.run([sys.executable, "-c", code, "emulate", str(program), "-o", str(out), "--jobs", "1",
+                          "--max-memory", "100G", "--quiet"], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 1, (run.returncode, run.stderr)
+    assert run.stderr.startswith("rend3r: error: out of memory") and "Traceback" not in run.stderr, run.stderr
+    assert not out.exists()

@@ -8,7 +8,8 @@ thresholds lets freed blocks be reused instead. The process then keeps up to
 ``TRIM_BYTES`` of freed memory for reuse, so this is a choice for the program, not for a
 library: the ``rend3r`` command makes it (as do the benchmarks, to measure what it runs);
 code that imports rend3r may call :func:`reuse_freed_memory` itself. Elsewhere than glibc
-this does nothing.
+this does nothing. The raytracer's large working arrays do not depend on it: they live in
+buffers kept per thread (``rend3r/emu/workspace.py``).
 
 Dask workers are processes of their own: this module is a Dask preload (``dask worker
 ADDRESS --preload rend3r.memory``; the local cluster's worker processes get it from

@@ -3,12 +3,15 @@
 A frame's working arrays (the shape tables, the hierarchy, the bundles' bounds, the bands'
 per-pixel arrays) and the processor's instruction lists and tables grow with the scene
 (a 65,536-sphere run at 512x384 keeps buffers of 115 MiB, 45 MiB of it instruction
-lists whose pages are mostly never touched). Allocated afresh each time, glibc gives them back
-to the kernel when they are freed (it trims the heap's top and unmaps large blocks), and
-the next run pays a page fault and a zeroed page for every 4 KiB it touches again: on
-this project's machine that was more than half of a 65,536-sphere run
-(``docs/performance.md``, "Working memory"). :func:`empty` hands out arrays in buffers
-it keeps, per thread, instead.
+lists whose pages are mostly never touched). Allocated afresh each time, glibc with its
+default thresholds gives them back to the kernel when they are freed (it trims the
+heap's top and unmaps large blocks), and the next run pays a page fault and a zeroed
+page for every 4 KiB it touches again: more than half of a 65,536-sphere run
+(``docs/performance.md``, "Working memory kept"). The ``rend3r`` command, the benchmarks
+and Dask workers raise those thresholds for the whole process (``rend3r/memory.py``), a
+choice a library must not make for the program that imports it; :func:`empty` keeps
+these arrays' memory in buffers of its own, per thread, so ``run_program`` called from
+any program is as fast as under the command.
 
 A buffer is handed out again only once nothing refers to it: every array made from it
 holds it (numpy's ``base``), so an array that is kept, or a view of it, keeps its buffer
@@ -24,7 +27,7 @@ from __future__ import annotations
 import math
 import sys
 import threading
-from bisect import bisect_left
+from bisect import bisect_left, bisect_right
 
 import numpy as np
 
@@ -78,9 +81,8 @@ def empty(shape: int | tuple[int, ...], dtype: np.dtype | type = np.float64) -> 
     if need < SMALLEST or _FREE is None:
         return np.empty(shape, dtype)
     kept = _buffers.kept
-    start = bisect_left(kept, need, key=len)
-    found = next((i for i in range(start, len(kept)) if len(kept[i]) <= _LOOSEST * need + SMALLEST
-                  and _refs(kept, i) == _FREE), -1)
+    start, stop = bisect_left(kept, need, key=len), bisect_right(kept, _LOOSEST * need + SMALLEST, key=len)
+    found = next((i for i in range(start, stop) if _refs(kept, i) == _FREE), -1)
     if found < 0:  # a new buffer, in place of the largest free one too small for it
         smaller = [i for i in range(start) if _refs(kept, i) == _FREE]
         if not smaller and len(kept) >= KEPT:

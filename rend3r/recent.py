@@ -26,6 +26,10 @@ class Recent(Generic[T]):
             raise ValueError(f"a Recent map holds at least one value, not {size}")
         self._size, self._values, self._lock = size, OrderedDict[Hashable, T](), Lock()
 
+    def __len__(self) -> int:
+        with self._lock:
+            return len(self._values)
+
     def get(self, key: Hashable, make: Callable[[], T]) -> T:
         """The value kept for ``key``, else ``make()`` kept for it (made outside the lock)."""
         with self._lock:

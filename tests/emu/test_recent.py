@@ -3,6 +3,7 @@ their camera or only a light against the reference renderer (nothing stale kept)
 
 from __future__ import annotations
 
+import sys
 import threading
 
 import pytest
@@ -46,13 +47,18 @@ def test_threads_share_it():
             value = recent.get(key, lambda key=key: (key, key * key))
             if value != (key, key * key):
                 wrong.append((key, value))
-            sizes.append(len(recent._values))
+            sizes.append(len(recent))  # under the map's lock: a bare read can see an insert before its eviction
 
     threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)  # threads switch often, so the lock's absence would show
+    try:
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+    finally:
+        sys.setswitchinterval(interval)
     assert not wrong and len(sizes) == 12000 and max(sizes) <= 4
 
 

@@ -94,7 +94,7 @@ class Tree:
         block.kind, block.tree, block.items = kind, bounds.view, len(self.items)
         block.box, block.own = address(bounds.box), address(own)
         block.node_keys = None if bounds.keys is None else address(bounds.keys)
-        block.jobs, block.avx2, block.chunk = jobs, native.avx2(), shape_bounds.SHAPE_CHUNK
+        block.jobs, block.isa, block.chunk = jobs, native.shape_isa(), shape_bounds.SHAPE_CHUNK
         return bounds, own
 
 

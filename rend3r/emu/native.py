@@ -129,7 +129,7 @@ class Bundle(Structure):
                 ("unit", c_void_p), ("u", c_double), ("tiny", c_double), ("overflow", c_double),
                 ("radius", c_void_p), ("floor", c_void_p), ("pc", c_void_p), ("behind", c_void_p),
                 ("keys", c_void_p), ("point", c_void_p), ("tree", Bvh), ("items", c_int64), ("box", c_void_p),
-                ("own", c_void_p), ("node_keys", c_void_p), ("jobs", c_int32), ("avx2", c_int32), ("chunk", c_int64)]
+                ("own", c_void_p), ("node_keys", c_void_p), ("jobs", c_int32), ("isa", c_int32), ("chunk", c_int64)]
 
 
 LF_PARALLEL, LF_APEX, LF_UNIT, LF_LENGTH, LF_AXES, LF_COLUMNS = 0, 1, 4, 7, 8, 14
@@ -143,7 +143,7 @@ class Bands(Structure):
                 ("shadow_origins", c_void_p), ("primary", POINTER(Bundle)), ("light_rows", c_void_p),
                 ("light_row", c_int64), ("lights", c_int64), ("light_frames", c_void_p), ("scales", c_void_p),
                 ("fixed", c_int32), ("item", c_int32), ("bounded", c_void_p), ("items", c_int64),
-                ("overflow", c_double), ("jobs", c_int32), ("avx2", c_int32), ("chunk", c_int64),
+                ("overflow", c_double), ("jobs", c_int32), ("isa", c_int32), ("chunk", c_int64),
                 ("min_chunk", c_int64), ("chunks_per_job", c_int64), ("counts", c_int64 * BC_COLUMNS),
                 ("memory", c_void_p), ("memory_bytes", c_int64)]
 
@@ -281,10 +281,15 @@ def runs(instruction_set: str) -> bool:
 
 
 def avx2() -> bool:
-    """Whether the passes that have an AVX2 copy and no other (the pairs' decoding, the
-    shapes' bounds: csrc/kernels.c, csrc/setup.c) take it: under either vector build (an
-    AVX-512 copy of the shape passes took the same time)."""
+    """Whether the pairs' decoding (csrc/kernels.c pair_apply), which has an AVX2 copy and
+    no other, takes it: under either vector build."""
     return isa() != "base"
+
+
+def shape_isa() -> int:
+    """Which copy of the shape passes (csrc/shape_bounds.inc) a Bundle or Bands block asks
+    for: 0 portable, 1 AVX2 (four lanes), 2 AVX-512 (eight lanes), the kernels' build's."""
+    return INSTRUCTION_SETS.index(isa())
 
 
 def narrow_format(f: FloatFormat) -> bool:

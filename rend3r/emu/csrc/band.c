@@ -187,7 +187,7 @@ static void shadow_bounds(const Bands *f, Team *team, Work *w, LightPass *lp, co
     const Band *b = f->band;
     Bundle bd = {.bnd = b->sh->bnd, .ok = f->bounded, .n = b->sh->n, .pass = PASS_SHADOW, .chord = NAN,
                  .u = b->sh->u, .tiny = b->sh->tiny, .overflow = f->overflow, .radius = w->radius, .tree = b->tree,
-                 .items = f->items, .box = w->box, .own = w->own, .jobs = f->jobs, .avx2 = f->avx2,
+                 .items = f->items, .box = w->box, .own = w->own, .jobs = f->jobs, .isa = f->isa,
                  .chunk = f->chunk};
     bd.tree.box = w->box;
     bd.tree.item_box = NULL;
@@ -233,7 +233,7 @@ static void shadow_bounds(const Bands *f, Team *team, Work *w, LightPass *lp, co
     } else {  /* infinite radii: every node holds every line */
         Bundle none = {.bnd = bd.bnd, .n = bd.n, .pass = PASS_NONE, .kind = lp->parallel ? BVH_FLAT : BVH_CONE,
                        .radius = w->radius, .tree = bd.tree, .items = bd.items, .box = w->box, .own = w->own,
-                       .jobs = bd.jobs, .avx2 = bd.avx2, .chunk = bd.chunk};
+                       .jobs = bd.jobs, .isa = bd.isa, .chunk = bd.chunk};
         memset(none.tree.frame, 0, sizeof none.tree.frame);
         none.tree.item_box = NULL;
         if (lp->parallel) {  /* the x and y axes */

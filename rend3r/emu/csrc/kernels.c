@@ -6,7 +6,8 @@
  * and instruction set in instances/: _f32 (fp32), _h16 (fp16, subnormals flushed), _h16i
  * (fp16, IEEE subnormals), _f64 (fp64), _nar and _fmt (other formats), each _base,
  * _avx2 and _avx512. This file holds the rest: the shape hierarchy, shadow grids and
- * bounds, in double (the shape passes in a _base and an _avx2 copy, shape_bounds.inc).
+ * bounds, in double (the shape passes in a _base, an _avx2 and an _avx512 copy,
+ * shape_bounds.inc).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -40,8 +41,8 @@ int32_t have_avx2(void)
 /* Whether this processor runs the AVX-512 build of the kernels (the _avx512 files of
  * instances/: the AVX2 build's code with AVX-512 F, VL, BW and DQ instructions; libgcc's
  * check also asks whether the system saves the AVX-512 registers). The shape passes
- * (shape_bounds.inc) and the pairs' decoding keep their AVX2 copies: an AVX-512 copy of
- * the shape passes took the same time (65,536 and 4,096 spheres, 2026-12-04). */
+ * (shape_bounds.inc) have an AVX-512 copy of their own, eight lanes wide; the pairs'
+ * decoding keeps its AVX2 copy. */
 int32_t have_avx512(void)
 {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -472,9 +473,7 @@ void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, con
 
 /* ---- bounds per shape (rend3r/emu/bounds.py) ---- */
 
-/* Four shapes' bound table columns (shape_bounds.inc). */
-typedef struct { f64x4 c[3], smin, smax; } Shapes4;
-
+#define LANES 4
 #define SB(name) name##_base
 #include "shape_bounds.inc"
 #undef SB
@@ -485,7 +484,16 @@ typedef struct { f64x4 c[3], smin, smax; } Shapes4;
 #include "shape_bounds.inc"
 #undef SB
 #pragma GCC pop_options
+#undef LANES
+#define LANES 8
+#pragma GCC push_options
+#pragma GCC target("avx2,avx512f,avx512vl,avx512bw,avx512dq")
+#define SB(name) name##_avx512
+#include "shape_bounds.inc"
+#undef SB
+#pragma GCC pop_options
 #endif
+#undef LANES
 
 /* ---- the instruction processor (rend3r/emu/processor.py) ---- */
 

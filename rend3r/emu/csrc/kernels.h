@@ -211,7 +211,7 @@ typedef struct {            /* one bundle of rays' bounds (setup.c bundle_bounds
     int64_t items;          /* the tree's items */
     double *box, *own;      /* out: nodes x BV_COLUMNS, items x CI_COLUMNS (cone) or BX_COLUMNS (flat) */
     double *node_keys;      /* out where keys or point is given: nodes x 3 or PK_COLUMNS */
-    int32_t jobs, avx2;     /* threads the passes split over; the AVX2 shape passes */
+    int32_t jobs, isa;      /* threads the passes split over; the shape passes' copy (native.py shape_isa) */
     int64_t chunk;          /* shapes or items a range takes at least */
 } Bundle;
 
@@ -243,7 +243,7 @@ typedef struct Bands {      /* a frame's bands, each rendered in one call (band.
     const uint8_t *bounded; /* per shape */
     int64_t items;          /* the tree's items */
     double overflow;        /* the precision's overflow threshold */
-    int32_t jobs, avx2;     /* threads the passes split over; the AVX2 shape passes */
+    int32_t jobs, isa;      /* threads the passes split over; the shape passes' copy (native.py shape_isa) */
     int64_t chunk;          /* shapes or items a range takes at least */
     int64_t min_chunk, chunks_per_job; /* pixels a chunk takes at least; the most chunks a thread takes */
     int64_t counts[BC_COLUMNS]; /* out: summed over the bands */

@@ -36,7 +36,8 @@ static int64_t shape_parts(int64_t n, int32_t jobs, int64_t smallest)
 SHAPE_PASSES(base)
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 SHAPE_PASSES(avx2)
-#define PICK(b, name) ((b)->avx2 ? name##_avx2 : name##_base)
+SHAPE_PASSES(avx512)
+#define PICK(b, name) ((b)->isa == 2 ? name##_avx512 : (b)->isa == 1 ? name##_avx2 : name##_base)
 #else
 #define PICK(b, name) name##_base
 #endif

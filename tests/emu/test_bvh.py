@@ -11,6 +11,8 @@ from hypothesis import given, settings, strategies as st
 
 from rend3r.emu import bounds, bvh, native
 
+from .test_engine_vs_reference import _same_bits
+
 STACK = 64  # csrc/bvh.h BVH_STACK
 
 
@@ -157,28 +159,6 @@ def test_refit_checks_its_arrays():
         tree.refit(bnd, np.ones(3))
 
 
-@settings(max_examples=20, derandomize=True)
-@given(st.integers(1, 400), st.integers(0, 2**32 - 1), st.integers(2, 5))
-def test_refit_on_threads_gives_the_same_bits(n, seed, jobs):
-    """Subtrees side by side, then the nodes above them: every node's bounds and keys
-    exactly as one thread computes them, for cones and boxes (small chunks force splits)."""
-    bnd, radius, floor = shapes(n, seed)
-    keys = np.random.default_rng(seed).normal(size=(n, 3))
-    tree = bvh.build(bnd, np.ones(n, bool))
-    chunk, bounds.SHAPE_CHUNK = bounds.SHAPE_CHUNK, 8
-    try:
-        for kw, columns in (({"apex": np.array([0.5, -1.0, 2.0])}, slice(None)),
-                            ({"axes": np.array([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0]]), "keys": keys},
-                             [0, 1, 2, 3, native.BV_FLOOR, *range(native.BV_FLOOR + 1, native.BV_COLUMNS)])):
-            one, many = (tree.refit(bnd, radius, floor, jobs=j, **kw) for j in (1, jobs))
-            assert one.box[:, columns].tobytes() == many.box[:, columns].tobytes()  # a box's columns
-            assert (one.keys is None) == (many.keys is None)
-            if one.keys is not None:
-                assert one.keys.tobytes() == many.keys.tobytes()
-    finally:
-        bounds.SHAPE_CHUNK = chunk
-
-
 def shadow_pass(bnd, ok, lo, hi, dmin, u, tiny, overflow, *, chord=np.nan, unit=None, length=0.0):
     """A light's shadow-ray pass over the shapes as csrc/band.c shadow_bounds fills it: for
     origins in the box lo..hi, a directional light along ``unit`` (its behind terms and
@@ -200,34 +180,69 @@ def shadow_pass(bnd, ok, lo, hi, dmin, u, tiny, overflow, *, chord=np.nan, unit=
     return p
 
 
+def fitted(bnd: np.ndarray, ok: np.ndarray, tree: bvh.Tree, jobs: int) -> list:
+    """A bundle's shape pass, own bounds and refit in one call (csrc/setup.c
+    bundle_bounds), for the primary rays and a directional and a point light's shadow
+    rays: every per-shape array and node bound they fill (None where a pass has none)."""
+    apex, axes, unit = np.array([0.5, -1.0, 2.0]), np.array([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0]]), np.array([0, 0, 1.0])
+    lo, hi, limits = bnd[:, :3].min(axis=0), bnd[:, :3].max(axis=0), (2.0**-24, 2.0**-126, 3.4e38)
+    passes = ((lambda: bounds.primary(bnd, ok, apex, 0.5, 2.0, *limits), {"apex": apex}),
+              (lambda: shadow_pass(bnd, ok, lo, hi, 2.0, *limits, unit=unit, length=2.0), {"axes": axes}),
+              (lambda: shadow_pass(bnd, ok, lo, hi, 0.5, *limits, chord=1e-3), {"apex": apex}))
+    out = []
+    for make, kw in passes:
+        p = make()
+        b = tree.fit(p, jobs=jobs, **kw)
+        box = b.box if "apex" in kw else np.delete(b.box, [4, 5], axis=1)  # a box's columns
+        out += [p.radius, p.floor, p.pc, p.behind, p.keys, box, b.keys, b.item_box]
+    return out
+
+
 @settings(max_examples=20, derandomize=True)
 @given(st.integers(1, 400), st.integers(0, 2**32 - 1), st.integers(2, 5))
 def test_shape_passes_on_threads_give_the_same_bits(n, seed, jobs):
-    """A bundle's shape pass, own bounds and refit in one call on a team of threads
-    (csrc/setup.c bundle_bounds): the primary rays' and both lights' shadow rays' per-shape
-    arrays and node bounds exactly as one thread computes them."""
+    """The bundles' passes on a team of threads: every per-shape array and node bound
+    exactly as one thread computes them."""
     bnd, _, _ = shapes(n, seed)
     ok = np.random.default_rng(seed).random(n) < 0.9
     tree = bvh.build(bnd, ok)
-    apex, axes, unit = np.array([0.5, -1.0, 2.0]), np.array([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0]]), np.array([0, 0, 1.0])
-    lo, hi, limits = bnd[:, :3].min(axis=0), bnd[:, :3].max(axis=0), (2.0**-24, 2.0**-126, 3.4e38)
-    passes = (lambda: bounds.primary(bnd, ok, apex, 0.5, 2.0, *limits), {"apex": apex},
-              lambda: shadow_pass(bnd, ok, lo, hi, 2.0, *limits, unit=unit, length=2.0), {"axes": axes},
-              lambda: shadow_pass(bnd, ok, lo, hi, 0.5, *limits, chord=1e-3), {"apex": apex})
     chunk, bounds.SHAPE_CHUNK = bounds.SHAPE_CHUNK, 8
     try:
-        for make, kw in zip(passes[::2], passes[1::2]):
-            runs = []
-            for j in (1, jobs):
-                p = make()
-                b = tree.fit(p, jobs=j, **kw)
-                box = b.box if "apex" in kw else np.delete(b.box, [4, 5], axis=1)  # a box's columns
-                runs.append([p.radius, p.floor, p.pc, p.behind, p.keys, box, b.keys, b.item_box])
-            for one, many in zip(*runs):
-                assert (one is None) == (many is None)
-                assert one is None or one.tobytes() == many.tobytes()
+        for one, many in zip(fitted(bnd, ok, tree, 1), fitted(bnd, ok, tree, jobs), strict=True):
+            assert (one is None) == (many is None)
+            assert one is None or one.tobytes() == many.tobytes()
     finally:
         bounds.SHAPE_CHUNK = chunk
+
+
+@settings(max_examples=40, derandomize=True)
+@given(st.integers(1, 400), st.integers(0, 2**32 - 1))
+def test_shape_passes_of_every_build_give_the_same_bits(n, seed):
+    """The shape passes' copies (csrc/shape_bounds.inc: four lanes portable and AVX2,
+    eight AVX-512), each under the kernels' build that picks it: every per-shape array and
+    node bound of the three bundles the same bit for bit (a NaN matching any NaN), for
+    counts of shapes that leave any tail of a vector, singular values apart."""
+    sets = [s for s in native.INSTRUCTION_SETS if native.runs(s)]
+    if len(sets) < 2:
+        pytest.skip("this processor runs one build of the kernels")
+    bnd, _, _ = shapes(n, seed)
+    rng = np.random.default_rng(seed)
+    bnd[:, 3] = rng.uniform(0.25, 2.0, n)
+    bnd[:, 4] = bnd[:, 3] * rng.uniform(1.0, 4.0, n)
+    ok = rng.random(n) < 0.9
+    tree = bvh.build(bnd, ok)
+    runs = []
+    try:
+        for name in sets:
+            native.choose(name)
+            assert native.shape_isa() == native.INSTRUCTION_SETS.index(name)
+            runs.append(fitted(bnd, ok, tree, 1))
+    finally:
+        native.choose(None)
+    for other in runs[1:]:
+        for a, b in zip(runs[0], other, strict=True):
+            assert (a is None) == (b is None)
+            assert a is None or _same_bits(a, b)
 
 
 @settings(max_examples=30, derandomize=True)

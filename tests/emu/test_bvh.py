@@ -159,6 +159,28 @@ def test_refit_checks_its_arrays():
         tree.refit(bnd, np.ones(3))
 
 
+@settings(max_examples=20, derandomize=True)
+@given(st.integers(1, 400), st.integers(0, 2**32 - 1), st.integers(2, 5))
+def test_refit_on_threads_gives_the_same_bits(n, seed, jobs):
+    """Subtrees side by side, then the nodes above them: every node's bounds and keys
+    exactly as one thread computes them, for cones and boxes (small chunks force splits)."""
+    bnd, radius, floor = shapes(n, seed)
+    keys = np.random.default_rng(seed).normal(size=(n, 3))
+    tree = bvh.build(bnd, np.ones(n, bool))
+    chunk, bounds.SHAPE_CHUNK = bounds.SHAPE_CHUNK, 8
+    try:
+        for kw, columns in (({"apex": np.array([0.5, -1.0, 2.0])}, slice(None)),
+                            ({"axes": np.array([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0]]), "keys": keys},
+                             [0, 1, 2, 3, native.BV_FLOOR, *range(native.BV_FLOOR + 1, native.BV_COLUMNS)])):
+            one, many = (tree.refit(bnd, radius, floor, jobs=j, **kw) for j in (1, jobs))
+            assert one.box[:, columns].tobytes() == many.box[:, columns].tobytes()  # a box's columns
+            assert (one.keys is None) == (many.keys is None)
+            if one.keys is not None:
+                assert one.keys.tobytes() == many.keys.tobytes()
+    finally:
+        bounds.SHAPE_CHUNK = chunk
+
+
 def shadow_pass(bnd, ok, lo, hi, dmin, u, tiny, overflow, *, chord=np.nan, unit=None, length=0.0):
     """A light's shadow-ray pass over the shapes as csrc/band.c shadow_bounds fills it: for
     origins in the box lo..hi, a directional light along ``unit`` (its behind terms and
@@ -221,7 +243,8 @@ def test_shape_passes_of_every_build_give_the_same_bits(n, seed):
     """The shape passes' copies (csrc/shape_bounds.inc: four lanes portable and AVX2,
     eight AVX-512), each under the kernels' build that picks it: every per-shape array and
     node bound of the three bundles the same bit for bit (a NaN matching any NaN), for
-    counts of shapes that leave any tail of a vector, singular values apart."""
+    counts of shapes that leave any tail of a vector and shapes whose smallest and largest
+    singular values differ."""
     sets = [s for s in native.INSTRUCTION_SETS if native.runs(s)]
     if len(sets) < 2:
         pytest.skip("this processor runs one build of the kernels")

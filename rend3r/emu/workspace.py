@@ -76,23 +76,24 @@ def empty(shape: int | tuple[int, ...], dtype: np.dtype | type = np.float64) -> 
     """An uninitialized C-contiguous array, as ``np.empty(shape, dtype)`` gives, in the
     smallest free buffer of this thread that holds it (a new one when none does)."""
     dtype = np.dtype(dtype)
-    shape = (int(shape),) if isinstance(shape, (int, np.integer)) else tuple(int(n) for n in shape)
+    shape = (int(shape),) if isinstance(shape, (int, np.integer)) else tuple(map(int, shape))
     need = math.prod(shape) * dtype.itemsize
     if need < SMALLEST or _FREE is None:
         return np.empty(shape, dtype)
     kept = _buffers.kept
     start, stop = bisect_left(kept, need, key=len), bisect_right(kept, _LOOSEST * need + SMALLEST, key=len)
-    found = next((i for i in range(start, stop) if _refs(kept, i) == _FREE), -1)
-    if found < 0:  # a new buffer, in place of the largest free one too small for it
-        smaller = [i for i in range(start) if _refs(kept, i) == _FREE]
-        if not smaller and len(kept) >= KEPT:
-            return np.empty(shape, dtype)
-        buf = np.empty(need + int(need * _SLACK), np.uint8)
-        if smaller:
-            del kept[smaller[-1]]
-        found = bisect_left(kept, len(buf), key=len)
-        kept.insert(found, buf)
-    return kept[found][:need].view(dtype).reshape(shape)
+    for i in range(start, stop):
+        if _refs(kept, i) == _FREE:
+            return np.ndarray(shape, dtype, kept[i])  # its base is the buffer: held while it lives
+    # a new buffer, in place of the largest free one too small for it
+    smaller = [i for i in range(start) if _refs(kept, i) == _FREE]
+    if not smaller and len(kept) >= KEPT:
+        return np.empty(shape, dtype)
+    buf = np.empty(need + int(need * _SLACK), np.uint8)
+    if smaller:
+        del kept[smaller[-1]]
+    kept.insert(bisect_left(kept, len(buf), key=len), buf)
+    return np.ndarray(shape, dtype, buf)
 
 
 def kept_bytes() -> int:

@@ -91,7 +91,7 @@ class Band(Structure):
 
 
 class Pairs(Structure):
-    """SE/SD pairs for pair_marks and pair_apply (csrc/kernels.c Pairs)."""
+    """SE/SD pairs for pairs_write (csrc/kernels.c Pairs)."""
 
     _fields_ = [("words", c_void_p), ("n_words", c_int64), ("at", c_void_p), ("n", c_int64), ("fields", c_void_p),
                 ("tables", c_void_p), ("entry", c_int32), ("wanted", c_void_p), ("null", c_void_p),
@@ -208,9 +208,8 @@ _PLAIN = {
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
     "stream_scan": (None, [c_void_p, c_int64, c_int64, c_int32, c_int32, c_int32, c_void_p, c_void_p, c_void_p]),
     "word_writes": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p]),
-    "pair_apply": (None, [POINTER(Pairs), c_void_p, c_void_p]),
-    "pair_marks_team": (None, [c_void_p, POINTER(Pairs), c_int64, c_void_p, c_void_p]),
-    "mark_rows": (c_int64, [c_void_p, c_int64, c_void_p, c_void_p]),
+    "pairs_write": (c_int64, [c_void_p, POINTER(Pairs), c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_int64,
+                              c_void_p, c_void_p, c_void_p]),
     "team_bytes": (c_int64, []),
     "team_open": (c_int32, [c_void_p, c_int32]),
     "team_close": (None, [c_void_p]),
@@ -281,7 +280,7 @@ def runs(instruction_set: str) -> bool:
 
 
 def avx2() -> bool:
-    """Whether the pairs' decoding (csrc/kernels.c pair_apply), which has an AVX2 copy and
+    """Whether the pairs' decoding (csrc/kernels.c pair_marks), which has an AVX2 copy and
     no other, takes it: under either vector build."""
     return isa() != "base"
 

@@ -240,17 +240,17 @@ _WANTED = {True: (("objects", 1 - _TRIANGLE_CODE), ("triangles", _TRIANGLE_CODE)
            False: (("objects", np.ones(len(_TABLES) + 1, np.uint8)),)}
 
 
-_MARKS = threading.local()
+class _Scratch(threading.local):
+    """A thread's arrays for pairs_write, kept for the next write (zeroing half a megabyte
+    for each pass cost more than the pass): a flag per index a shape can have (all zero
+    between writes), and a row per index."""
+
+    def __init__(self) -> None:
+        self.mark = np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
+        self.row_of = np.empty(SHAPE_INDEX_LIMIT, np.int32)
 
 
-def _marks() -> np.ndarray:
-    """This thread's mark array for pair_marks (SHAPE_INDEX_LIMIT bytes, all zero), kept
-    for the next write: zeroing half a megabyte for each pass cost more than the pass."""
-    mark = getattr(_MARKS, "mark", None)
-    if mark is None:
-        mark = _MARKS.mark = np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
-    return mark
-
+_SCRATCH = _Scratch()
 
 #: Pairs a thread takes at least (pair_marks takes about 2 ns a pair: a range of these is
 #: about ten times what a team takes to hand it over).
@@ -260,32 +260,31 @@ PAIR_CHUNK = 1 << 12
 def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, entry: int, wanted: np.ndarray,
                  table: ObjectTable, jobs: int) -> None:
     """Apply the SE/SD pairs at ``at`` (each writes prop then prop2; a write to a null
-    property stores nothing) that ``wanted`` takes to ``table``, in compiled passes
-    (csrc/kernels.c): over their words, the indices written and each pair decoded (in
-    ranges of pairs on a team of ``jobs`` threads when there are many), then over the
-    decoded pairs the writes, in order (threads that each took a range of rows spent
-    nearly as long reading every pair as one thread writing them all)."""
+    property stores nothing) that ``wanted`` takes to ``table``, in one compiled call
+    (csrc/kernels.c pairs_write): over their words, the indices written and each pair
+    decoded (in ranges of pairs on a team of ``jobs`` threads when there are many), the
+    table's rows for them, then over the decoded pairs the writes, in order (threads that
+    each took a range of rows spent nearly as long reading every pair as one thread
+    writing them all). A new index gets a new table, its rows in index order."""
     records = empty(len(at), np.uint64)  # each pair decoded once, by pair_marks for pair_apply
     pairs = native.Pairs(address(words), len(words), address(at), len(at), address(_PAIR_FIELDS),
                          None if tables is None else address(tables), entry, address(wanted), address(_SE_NULL),
                          address(records), native.avx2())
-    lib, mark, top = native.library(), _marks(), -1
+    scratch, had = _SCRATCH, len(table.index)
     count = threads.parts(len(at), jobs, PAIR_CHUNK)
     tops = np.empty(count, np.int64)
-    try:
-        with threads.team(jobs if count > 1 else 1) as team:
-            lib.pair_marks_team(team, byref(pairs), count, address(mark), address(tops))
-        # the first pair without its SD: range k starts at len(at) * k // count (csrc/kernels.c pair_range)
+    index, values = empty(had + len(at) + 1, np.int64), empty((had + len(at), PROP_LIMIT), np.uint16)
+    with threads.team(jobs if count > 1 else 1) as team:
+        rows = native.library().pairs_write(team, byref(pairs), count, address(scratch.mark), address(tops),
+                                            address(scratch.row_of), native.ptr(table.index, np.int64, (had,)), had,
+                                            native.ptr(table.values, np.uint16, (had, PROP_LIMIT)), address(index),
+                                            address(values))
+    if rows < 0:  # the first pair without its SD: range k starts at len(at) * k // count (csrc/kernels.c pair_range)
+        scratch.mark[:] = 0
         bad = [len(at) * k // count - 1 - t for k, t in enumerate(tops.tolist()) if t < 0]
-        if bad:
-            raise Rend3rError(f"{_where(int(at[bad[0]]))}: an SE word without its SD")
-        top = max(tops.tolist())
-        if top:
-            row_of = table.grow(mark, top)
-            lib.pair_apply(byref(pairs), address(row_of), native.ptr(table.values, np.uint16, (None, PROP_LIMIT)))
-    finally:  # the marks lie below the largest index written and the table's largest (grow's)
-        last = int(table.index[-1]) + 1 if len(table.index) else 0
-        mark[:SHAPE_INDEX_LIMIT if top < 0 else max(top, last)] = 0
+        raise Rend3rError(f"{_where(int(at[bad[0]]))}: an SE word without its SD")
+    if rows > had:
+        table.index, table.values = index[:rows], values[:rows]
 
 
 @dataclass(frozen=True)

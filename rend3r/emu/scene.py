@@ -15,8 +15,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..isa import Table, lookup
-from ..isa.tables import PROP_LIMIT, SHAPE_INDEX_LIMIT
-from .workspace import empty
+from ..isa.tables import PROP_LIMIT
 
 
 @lru_cache(maxsize=256)
@@ -45,29 +44,6 @@ class ObjectTable:
 
     def __len__(self) -> int:
         return len(self.index)
-
-    def grow(self, mark: np.ndarray, top: int) -> np.ndarray:
-        """Rows for the indices written: ``mark`` (uint8, one per index a shape can have,
-        SHAPE_INDEX_LIMIT) is 1 at each, all below ``top``. Adds a zero row for each new
-        index (a dense map over the index range: no sort) and returns the row of every
-        index below ``top`` that has one (int32; the others are undefined)."""
-        if mark.shape != (SHAPE_INDEX_LIMIT,) or mark.dtype != np.uint8:
-            raise ValueError(f"grow: the marks must be {SHAPE_INDEX_LIMIT} bytes")
-        from .native import address, library  # the compiled pass: numpy's nonzero and scatter took twice as long
-
-        had = len(self.index)
-        if had:
-            top = max(top, int(self.index[-1]) + 1)
-            mark[self.index] = 1
-        row_of, merged = empty(top, np.int32), empty(top, np.int64)
-        merged = merged[:library().mark_rows(address(mark), top, address(row_of), address(merged))]
-        if len(merged) > had:
-            values = empty((len(merged), PROP_LIMIT), np.uint16)
-            values.view(np.uint64).fill(0)  # kept memory (workspace.py), zeroed 8 bytes at a time
-            if had:
-                values[row_of[self.index]] = self.values
-            self.index, self.values = merged, values
-        return row_of
 
     def copy(self) -> ObjectTable:
         """A copy that later writes to this table leave as it is."""

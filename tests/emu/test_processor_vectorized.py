@@ -19,7 +19,7 @@ from rend3r.isa import (
     CameraSet, FrameOp, Func, LightSet, ShapeSet, Table, TrailingSE, Unknown, ValueType, by_index, decode_word, encode,
 )
 from rend3r.isa.extensions import decode_table_select, table_select_word
-from rend3r.isa.tables import OPCODE, SHAPE_INDEX_LIMIT, UNUSED_OPCODES, Opcode
+from rend3r.isa.tables import OPCODE, UNUSED_OPCODES, Opcode
 
 Objects = dict[int, tuple[int, ...]]  # index -> the 32 property words (0 where unwritten)
 State = tuple[dict[int, int], dict[int, dict[int, int]], Objects, Objects]
@@ -276,24 +276,30 @@ def test_last_write_wins_across_many_words():
         _check(words, EmuOptions(mode=mode))
 
 
-def test_object_table_grow_and_row():
-    t = ObjectTable()
-    mark = np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
-    mark[[5, 2]] = 1
-    row_of = t.grow(mark, 6)
-    t.values[row_of[5], 1], t.values[row_of[2], 3] = 30, 20
-    assert t.index.tolist() == [2, 5] and t.row(5) == {1: 30} and t.row(2) == {3: 20}
-    mark = np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
-    mark[3] = 1
-    row_of = t.grow(mark, 4)  # a new index below the others: rows move, values with them
-    t.values[row_of[5], 2] = 7
-    assert t.index.tolist() == [2, 3, 5] and t.row(3) == {} and t.row(5) == {1: 30, 2: 7} and len(t) == 3
+def test_new_indices_merge_into_the_table_in_index_order():
+    """A later frame's pairs add indices below, between and above the table's (rows move
+    with their values), write in place when no index is new, and a pair that stores
+    nothing adds no row; the scenes are the reference's."""
+    a, b = [p for p in range(32) if not _null(Table.SHAPE, p)][:2]
+    null = next(p for p in range(32) if _null(Table.SHAPE, p))
+
+    def pair(index: int, prop: int, data: int) -> list[int]:
+        return list(encode(ShapeSet(index, prop, prop, data, data)))
+
+    words = [NR, *pair(5, a, 30), *pair(2, b, 20), NF, *pair(3, a, 1), *pair(5, b, 7), *pair(9, a, 4), NF,
+             *pair(5, a, 8), NF, *pair(1, null, 6), NF]
+    _, seen, _ = vectorized(words, EmuOptions())
+    assert [list(state[2]) for state in seen] == [[2, 5], [2, 3, 5, 9], [2, 3, 5, 9], [2, 3, 5, 9]]
+    assert seen[1][2][5][a] == 30 and seen[1][2][5][b] == 7 and seen[1][2][3][a] == 1 and seen[1][2][2][b] == 20
+    assert seen[2][2][5][a] == 8 and seen[2][2][2][b] == 20
+    _check(words)
+    table = Scene().objects
+    execute(words, EmuOptions(), scene=Scene(objects=table))
+    assert table.row(5) == {a: 8, b: 7} and len(table) == 4
     with pytest.raises(KeyError):
-        t.row(4)
-    with pytest.raises(ValueError, match="marks"):
-        t.grow(np.zeros(10, np.uint8), 1)
-    t.clear()
-    assert len(t) == 0
+        table.row(4)
+    table.clear()
+    assert len(table) == 0
 
 
 @settings(max_examples=300)

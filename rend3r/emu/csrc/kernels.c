@@ -773,7 +773,7 @@ static inline __attribute__((always_inline)) int64_t marks(const Pairs *p, uint8
     return m.top;
 }
 
-int64_t pair_marks(const Pairs *p, uint8_t *mark)
+static int64_t pair_marks(const Pairs *p, uint8_t *mark)
 {
     return p->tables == NULL ? marks(p, mark, 1) : marks(p, mark, 0);  /* NULL: no TS word, one table */
 }
@@ -799,7 +799,7 @@ static void pair_range(void *ctx, int64_t k)
 
 /* pair_marks over `parts` ranges of the pairs on a team (team.h), range k's result into
  * tops[k]. */
-void pair_marks_team(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, int64_t *tops)
+static void pair_marks_team(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, int64_t *tops)
 {
     PairRanges r = {p, parts < 1 ? 1 : parts, mark, tops};
     team_phase(team, pair_range, &r, r.parts);
@@ -809,7 +809,7 @@ void pair_marks_team(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, i
  * write to a word wins), row row_of[index], from the records pair_marks decoded. The row
  * of the last index is kept: a shape's pairs mostly come together, and a store whose
  * address waits on a row_of load each time ran at half the speed. */
-void pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values)
+static void pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values)
 {
     const uint64_t *records = p->records;
     int64_t n = p->n, last = -1;
@@ -834,7 +834,7 @@ void pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values)
 /* The rows of the indices marked below top (mark[i] != 0), in index order: row_of[i] of
  * each marked i (the others' are left undefined), and the marked indices into index
  * (room for top). Returns how many are marked. */
-int64_t mark_rows(const uint8_t *mark, int64_t top, int32_t *row_of, int64_t *index)
+static int64_t mark_rows(const uint8_t *mark, int64_t top, int32_t *row_of, int64_t *index)
 {
     int64_t r = 0;
     for (int64_t i = 0; i < top; i++) {
@@ -843,6 +843,44 @@ int64_t mark_rows(const uint8_t *mark, int64_t top, int32_t *row_of, int64_t *in
         r += mark[i] != 0;
     }
     return r;
+}
+
+/* The pairs p written to an object table of `had` rows (index: sorted, values: PROP_WORDS
+ * words a row) in one call (processor.py _write_pairs; Python between these steps cost
+ * more than they did at 4,096 shapes): pair_marks over `parts` ranges of the pairs on a
+ * team, range k's result into tops[k]; the rows of the indices written merged with the
+ * table's (mark_rows); then the writes (pair_apply). When an index is new, the merged
+ * table goes to index_out and values_out (room for had + p->n rows and one more index),
+ * new rows zero; else the writes go to values in place. mark (an index's flag, all zero)
+ * and row_of (an index's row) are the caller's, 2^19 entries each: mark is zero again on
+ * return unless a range fails. Returns the table's rows, or -1 when a range holds a pair
+ * without its SD (tops[k] < 0 tells which; nothing is written). */
+int64_t pairs_write(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, int64_t *tops, int32_t *row_of,
+                    const int64_t *index, int64_t had, uint16_t *values, int64_t *index_out, uint16_t *values_out)
+{
+    pair_marks_team(team, p, parts, mark, tops);
+    int64_t top = 0;
+    for (int64_t k = 0; k < parts; k++) {
+        if (tops[k] < 0)
+            return -1;
+        top = tops[k] > top ? tops[k] : top;
+    }
+    if (top == 0)  /* no pair stores a word */
+        return had;
+    for (int64_t i = 0; i < had; i++)
+        mark[index[i]] = 1;
+    top = had && index[had - 1] >= top ? index[had - 1] + 1 : top;
+    int64_t rows = mark_rows(mark, top, row_of, index_out);
+    memset(mark, 0, (size_t)top);
+    if (rows > had) {
+        memset(values_out, 0, (size_t)rows * PROP_WORDS * sizeof *values_out);
+        for (int64_t i = 0; i < had; i++)
+            memcpy(values_out + PROP_WORDS * (int64_t)row_of[index[i]], values + PROP_WORDS * i,
+                   PROP_WORDS * sizeof *values);
+        values = values_out;
+    }
+    pair_apply(p, row_of, values);
+    return rows;
 }
 
 /* ---- rounding, for tests ---- */

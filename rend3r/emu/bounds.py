@@ -19,7 +19,7 @@ import numpy as np
 
 from . import native
 from .native import address
-from .workspace import empty
+from .workspace import arrays, empty
 
 #: Shapes or items a range of a set-up pass takes at least (csrc/setup.c): the passes take
 #: about 30 ns a shape, and a team of threads hands a range over in about a microsecond.
@@ -50,8 +50,8 @@ def primary(table: np.ndarray, ok: np.ndarray, apex: np.ndarray, dmin: float, dm
     (``csrc/kernels.h`` PC_COLUMNS); ``u``, ``tiny`` and ``overflow`` are the precision's
     unit roundoff, smallest normal and overflow threshold."""
     n = len(table)
-    p = shape_pass(table, ok, u, tiny, overflow, native.PASS_PRIMARY, floor=empty(n),
-                   pc=empty((n, native.PC_COLUMNS)))
+    radius, floor, pc = arrays((n, np.float64), (n, np.float64), ((n, native.PC_COLUMNS), np.float64))
+    p = shape_pass(table, ok, u, tiny, overflow, native.PASS_PRIMARY, radius=radius, floor=floor, pc=pc)
     p.block.apex[:] = [float(c) for c in apex]
     p.block.dmin, p.block.dmax = dmin, dmax
     p.block.floor, p.block.pc = address(p.floor), address(p.pc)
@@ -59,14 +59,14 @@ def primary(table: np.ndarray, ok: np.ndarray, apex: np.ndarray, dmin: float, dm
 
 
 def shape_pass(table: np.ndarray, ok: np.ndarray, u: float, tiny: float, overflow: float, kind: int,
-               **arrays: np.ndarray) -> Pass:
+               radius: np.ndarray | None = None, **others: np.ndarray) -> Pass:
     """A pass of ``kind`` (native.PASS_*): its block over the checked table and uint8 flags,
-    with its radius array (``arrays``: the Pass's others)."""
+    with its radius array (None: a new one; ``others``: the Pass's other arrays)."""
     n = len(table)
     native.ptr(table, np.float64, (n, native.B_COLUMNS))
     flags = np.ascontiguousarray(ok, np.uint8)
     native.ptr(flags, np.uint8, (n,))
-    p = Pass(native.Bundle(), table, flags, empty(n), **arrays)
+    p = Pass(native.Bundle(), table, flags, empty(n) if radius is None else radius, **others)
     b = p.block
     b.bnd, b.ok, b.n, b.radius, b.pass_ = address(table), address(flags), n, address(p.radius), kind
     b.u, b.tiny, b.overflow = u, tiny, overflow

@@ -20,7 +20,7 @@ import numpy as np
 
 from . import bounds as shape_bounds, native, threads
 from .native import address
-from .workspace import empty
+from .workspace import arrays, empty
 
 
 @dataclass(frozen=True)
@@ -88,9 +88,10 @@ class Tree:
         frame = np.zeros(6)
         frame[: 3 if apex is not None else 6] = np.ravel(apex if apex is not None else axes)
         # each shape's own cone (a scratch array) or box (kept: shadow packets test it), then the nodes'
-        own = empty((len(self.items), native.CI_COLUMNS if apex is not None else native.BX_COLUMNS))
-        bounds = Bounds(self, empty((nodes, native.BV_COLUMNS)), frame, own if axes is not None else None,
-                        None if not keys else empty((nodes, 3 if axes is not None else native.PK_COLUMNS)))
+        own, box, node_keys = arrays(((len(self.items), native.CI_COLUMNS if apex is not None else native.BX_COLUMNS),
+                                      np.float64), ((nodes, native.BV_COLUMNS), np.float64),
+                                     ((nodes if keys else 0, 3 if axes is not None else native.PK_COLUMNS), np.float64))
+        bounds = Bounds(self, box, frame, own if axes is not None else None, node_keys if keys else None)
         block.kind, block.tree, block.items = kind, bounds.view, len(self.items)
         block.box, block.own = address(bounds.box), address(own)
         block.node_keys = None if bounds.keys is None else address(bounds.keys)

@@ -36,7 +36,7 @@ from . import native, threads
 from .native import address
 from .options import EmuOptions
 from .scene import ObjectTable, Scene
-from .workspace import empty
+from .workspace import arrays, empty
 
 #: Called at each ``nf`` with the scene and the frame number (0-based).
 RenderHook = Callable[[Scene, int], None]
@@ -123,12 +123,11 @@ class _Stream:
     def __init__(self, prog: _Program, start: int) -> None:
         self.prog, self.start = prog, start
         room = max(0, len(prog.words) - start)
-        lists, count = empty((_LISTS, room), np.int64), np.zeros(_LISTS, np.int64)
-        at = address(lists) + lists.strides[0] * np.arange(_LISTS, dtype=np.int64)
+        lists, count = empty((_LISTS, room), np.int64), np.empty(_LISTS, np.int64)
         native.library().stream_scan(address(prog.words), len(prog.words), start, OPCODE.lo, OPCODE.width, FUNC.lo,
-                                     address(_KIND), address(at), address(count))
+                                     address(_KIND), address(lists), room, address(count))
         # Addresses of the instructions per list (_KIND), in order; an SE's pair is one instruction.
-        self.by_kind = [a[:c] for a, c in zip(lists, count.tolist())]
+        self.by_kind = [lists[k, :c] for k, c in enumerate(count.tolist())]
         self._find_stop()
 
     def _find_stop(self) -> None:
@@ -266,14 +265,14 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
     table's rows for them, then over the decoded pairs the writes, in order (threads that
     each took a range of rows spent nearly as long reading every pair as one thread
     writing them all). A new index gets a new table, its rows in index order."""
-    records = empty(len(at), np.uint64)  # each pair decoded once, by pair_marks for pair_apply
+    scratch, had = _SCRATCH, len(table.index)
+    records, index, values = arrays(  # records: each pair decoded once, by pair_marks for pair_apply
+        (len(at), np.uint64), (had + len(at) + 1, np.int64), ((had + len(at), PROP_LIMIT), np.uint16))
     pairs = native.Pairs(address(words), len(words), address(at), len(at), address(_PAIR_FIELDS),
                          None if tables is None else address(tables), entry, address(wanted), address(_SE_NULL),
                          address(records), native.avx2())
-    scratch, had = _SCRATCH, len(table.index)
     count = threads.parts(len(at), jobs, PAIR_CHUNK)
     tops = np.empty(count, np.int64)
-    index, values = empty(had + len(at) + 1, np.int64), empty((had + len(at), PROP_LIMIT), np.uint16)
     with threads.team(jobs if count > 1 else 1) as team:
         rows = native.library().pairs_write(team, byref(pairs), count, address(scratch.mark), address(tops),
                                             address(scratch.row_of), native.ptr(table.index, np.int64, (had,)), had,

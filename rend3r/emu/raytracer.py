@@ -46,7 +46,7 @@ from .lights import POINT, Light, lights_from_scene, lights_key
 from .options import EmuOptions
 from .scene import Scene, prop_index
 from .stats import FrameStats
-from .workspace import empty
+from .workspace import arrays, empty
 
 Progress = Callable[[float], None]
 #: Pixels per band at most: bounds the per-pixel working arrays (about 100 bytes per pixel).
@@ -228,13 +228,13 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
     s = native.Setup(native.kernel_address("shape_tables", ar),
                      native.ptr(values, np.uint16, (rows, PROP_LIMIT)), address(index), rows, address(_SHAPE_PROPS),
                      address(_KINDS), native.ptr(cam, dtype, (native.CAM_COLUMNS,)), ar.tiny, fmt)
-    sf = empty((rows, native.SF_COLUMNS), dtype)  # frame_setup fills them
-    si, bnd = empty((rows, native.SI_COLUMNS), np.int64), empty((rows, native.B_COLUMNS))
-    bounded, out = empty(rows, np.uint8), empty(rows, np.int32)
+    sf, si, bnd, bounded, out, node, items, always, build = arrays(  # frame_setup fills them; build: its working copies
+        ((rows, native.SF_COLUMNS), dtype), ((rows, native.SI_COLUMNS), np.int64), ((rows, native.B_COLUMNS), np.float64),
+        (rows, np.uint8), (rows, np.int32), ((max(1, 2 * rows), 2), np.int32), (rows, np.int32), (rows, np.int32),
+        (rows * native.BUILD_BYTES // 8, np.uint64))
     s.sf, s.sf_row, s.si, s.bnd, s.bounded, s.index_out = (address(sf), sf.strides[0], address(si), address(bnd),
                                                            address(bounded), address(out))
-    room = bvh.Tree(empty((max(1, 2 * rows), 2), np.int32), empty(rows, np.int32), empty(rows, np.int32))
-    build = empty(rows * native.BUILD_BYTES // 8, np.uint64)  # the build's working copies
+    room = bvh.Tree(node, items, always)
     s.node, s.items, s.always, s.room = address(room.node), address(room.items), address(room.always), address(build)
     s.jobs, s.chunk = jobs, bounds.SHAPE_CHUNK
     first = None

@@ -106,6 +106,32 @@ def _not_too_loose() -> None:
     assert again.ctypes.data == at
 
 
+def test_arrays_share_a_buffer_held_while_any_of_them_lives() -> None:
+    _on_a_thread_of_its_own(_arrays_in_one_buffer)
+
+
+def _arrays_in_one_buffer() -> None:
+    specs = (((BIG // 8, 3), np.float64), (5, np.uint8), (0, np.int32), ((7, 2), np.int64), (BIG, np.uint16))
+    got = workspace.arrays(*specs)
+    assert [(a.shape, a.dtype) for a in got] == [((BIG // 8, 3), np.float64), ((5,), np.uint8), ((0,), np.int32),
+                                                 ((7, 2), np.int64), ((BIG,), np.uint16)]
+    assert all(a.flags.c_contiguous and a.flags.writeable for a in got)
+    base = got[0].ctypes.data
+    spans = sorted((a.ctypes.data - base, a.ctypes.data - base + a.nbytes) for a in got if a.nbytes)
+    assert all(start % 64 == 0 for start, _ in spans)
+    assert all(end <= start for (_, end), (start, _) in zip(spans, spans[1:]))  # none overlaps the next
+    for a, value in zip(got, range(1, 6)):
+        a[...] = value
+    assert [int(a.max(initial=0)) for a in got] == [1, 2, 0, 4, 5]  # each kept its own values
+    kept = got[3]
+    del got, a
+    again = workspace.arrays(*specs)
+    second = again[0].ctypes.data
+    assert second != base  # the small array alive holds the whole buffer
+    del kept, again
+    assert workspace.arrays(*specs)[0].ctypes.data in (base, second)  # both buffers free again
+
+
 def test_each_thread_has_its_own_buffers() -> None:
     """A buffer freed on one thread, which stays alive, is not handed to another."""
     freed, done = threading.Event(), threading.Event()

@@ -502,16 +502,16 @@ void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, con
  * any other word is one instruction. Each instruction's address goes to a list, in address
  * order: list kind[opcode] (0 unknown opcodes, 1 C, 2 L, 3 SE), and for the frame-control
  * opcode (its kind is 4) list 4 + the word's two-bit function field (ER, NR, NF, LR).
- * count[k] is how many list k got; each has room for n - start addresses. The counts stay
+ * List k is lists + k * room (room: at least n - start); count[k] is how many it got. The counts stay
  * in locals (an array indexed by the kind put a store and a load on each word's path).
  * Runs of pairs are read eight pairs at a time (a 65,536-sphere program's 655,373 words
  * took 0.3 ms a word or a pair at a time). */
 void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo, int32_t op_width, int32_t func_lo,
-                 const uint8_t *kind, int64_t *const *lists, int64_t *count)
+                 const uint8_t *kind, int64_t *lists, int64_t room, int64_t *count)
 {
     uint32_t mask = (1u << op_width) - 1u;
-    int64_t *unknown = lists[0], *camera = lists[1], *light = lists[2], *pair = lists[3];
-    int64_t *er = lists[4], *nr = lists[5], *nf = lists[6], *lr = lists[7];
+    int64_t *unknown = lists, *camera = lists + room, *light = lists + 2 * room, *pair = lists + 3 * room;
+    int64_t *er = lists + 4 * room, *nr = lists + 5 * room, *nf = lists + 6 * room, *lr = lists + 7 * room;
     int64_t c0 = 0, c1 = 0, c2 = 0, c3 = 0, c4 = 0, c5 = 0, c6 = 0, c7 = 0;
     int64_t se_op = -1;  /* the one opcode of list 3, else negative */
     for (uint32_t op = 0; op <= mask; op++)

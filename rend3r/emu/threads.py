@@ -16,9 +16,6 @@ from __future__ import annotations
 
 import os
 import threading
-from functools import lru_cache
-
-import numpy as np
 
 from . import native
 
@@ -51,23 +48,19 @@ class team:  # noqa: N801 (used as a function: with threads.team(jobs) as at)
     pool serves that one, and this one's calls run on this thread alone."""
 
     def __init__(self, jobs: int) -> None:
-        self.jobs, self.state = jobs, None
+        self.jobs, self.at = jobs, None
 
     def __enter__(self) -> int:
         led = getattr(_LED, "team", None)
         if led is not None:
             return led
-        self.state = np.zeros(_team_bytes(), np.uint8)
-        at = _LED.team = native.address(self.state)
-        native.library().team_open(at, self.jobs - 1)
+        at = native.library().team_open(self.jobs - 1)
+        if not at:
+            raise MemoryError("no memory for a team of threads")
+        self.at = _LED.team = at
         return at
 
     def __exit__(self, *_: object) -> None:
-        if self.state is not None:
+        if self.at is not None:
             _LED.team = None
-            native.library().team_close(native.address(self.state))  # returns once no member is inside it
-
-
-@lru_cache(maxsize=1)
-def _team_bytes() -> int:
-    return native.library().team_bytes()
+            native.library().team_close(self.at)  # without waiting: the last member out frees it

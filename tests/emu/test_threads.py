@@ -41,6 +41,36 @@ def test_a_team_is_led_once_per_thread_and_ends_with_its_block():
     subprocess.run([sys.executable, "-c", code], check=True, timeout=30)
 
 
+def test_teams_opened_and_closed_in_quick_succession_on_two_threads():
+    """A team's memory goes with its last reference, the leader's close or a member's
+    leaving, whichever comes last: thousands of teams opened and closed at once from two
+    threads (only one has the pool's threads at a time), half of them rendering a frame,
+    in a process of its own so that a fault shows as its exit status."""
+    code = (
+        "import sys, threading\n"
+        "sys.path.insert(0, 'benchmarks')\n"
+        "import walls\n"
+        "from rend3r.emu import bounds, raytracer, threads\n"
+        "from rend3r.emu.options import EmuOptions\n"
+        "from rend3r.emu.run import run_program\n"
+        "raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK = 16, 8  # every pass split\n"
+        "w = walls.wall(16, 1)\n"
+        "frame = lambda j: run_program(w.words, EmuOptions(precision='fp32', jobs=j, width=16, height=12)).frames[0]\n"
+        "one = frame(1).rgb565.tobytes()\n"
+        "bad = []\n"
+        "def churn():\n"
+        "    for k in range(1500):\n"
+        "        with threads.team(2):\n"
+        "            pass\n"
+        "        if frame(2).rgb565.tobytes() != one:  # its team closes as the member spins in it\n"
+        "            bad.append(k)\n"
+        "ts = [threading.Thread(target=churn) for _ in range(2)]\n"
+        "[t.start() for t in ts]\n"
+        "[t.join() for t in ts]\n"
+        "sys.exit(1 if bad else 0)\n")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120, cwd=ROOT)
+
+
 def test_a_forked_child_starts_its_own_team_threads():
     """The pool's threads do not survive a fork: a child that renders with two jobs starts
     its own, and gets the frames its parent gets with one."""

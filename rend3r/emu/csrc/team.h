@@ -3,7 +3,7 @@
  * a Python thread (its wake-up, then the GIL) costs about as much as such a pass.
  *
  * The thread that opens a team leads it (team_open, team_close; threads.py team keeps
- * one open while a frame renders): it releases phases one after another, each a list of
+ * one open while a program runs): it releases phases one after another, each a list of
  * tasks, takes tasks itself and waits until every task of the phase has finished. The
  * members are native threads of a pool (team.c), which wait spinning for the next phase
  * and take the next task not yet taken of the phase released last. A member may join
@@ -53,7 +53,7 @@ typedef struct {
     TEAM_ATOMIC(int64_t) released;  /* the phase released last (1, 2, ...; 0: none yet), TEAM_ENDED once ended */
     TEAM_ATOMIC(uint64_t) claim;    /* that phase << 32 | its next task not yet taken */
     int64_t phases;                 /* the leader's count of phases */
-    TEAM_ATOMIC(int32_t) inside;    /* members inside the team (team.c: its memory goes when none is) */
+    TEAM_ATOMIC(int32_t) refs;      /* the leader until it closes the team, and each member inside it */
     TeamPhase ring[TEAM_RING];
 } Team;
 

@@ -91,7 +91,7 @@ class Band(Structure):
 
 
 class Pairs(Structure):
-    """SE/SD pairs for pairs_write (csrc/kernels.c Pairs)."""
+    """SE/SD pairs for pairs_rows and pairs_grow (csrc/kernels.c Pairs)."""
 
     _fields_ = [("words", c_void_p), ("n_words", c_int64), ("at", c_void_p), ("n", c_int64), ("fields", c_void_p),
                 ("tables", c_void_p), ("entry", c_int32), ("wanted", c_void_p), ("null", c_void_p),
@@ -209,8 +209,10 @@ _PLAIN = {
     "stream_scan": (None, [c_void_p, c_int64, c_int64, c_int32, c_int32, c_int32, c_void_p, c_void_p, c_int64,
                            c_void_p]),
     "word_writes": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p]),
-    "pairs_write": (c_int64, [c_void_p, POINTER(Pairs), c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_int64,
-                              c_void_p, c_void_p, c_void_p]),
+    "pairs_rows": (c_int64, [c_void_p, POINTER(Pairs), c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p,
+                             c_int64, c_void_p]),
+    "pairs_grow": (None, [POINTER(Pairs), c_void_p, c_void_p, c_void_p, c_int64, c_void_p, c_int64, c_void_p, c_void_p,
+                          c_void_p]),
     "team_open": (c_void_p, [c_int32]),
     "team_close": (None, [c_void_p]),
     "frame_setup": (c_int64, [POINTER(Setup), POINTER(Bundle), c_void_p]),

@@ -36,7 +36,7 @@ from . import native, threads
 from .native import address
 from .options import EmuOptions
 from .scene import ObjectTable, Scene
-from .workspace import arrays, empty
+from .workspace import empty
 
 #: Called at each ``nf`` with the scene and the frame number (0-based).
 RenderHook = Callable[[Scene, int], None]
@@ -240,13 +240,14 @@ _WANTED = {True: (("objects", 1 - _TRIANGLE_CODE), ("triangles", _TRIANGLE_CODE)
 
 
 class _Scratch(threading.local):
-    """A thread's arrays for pairs_write, kept for the next write (zeroing half a megabyte
-    for each pass cost more than the pass): a flag per index a shape can have (all zero
-    between writes), and a row per index."""
+    """A thread's arrays for the pair writes, kept for the next write (zeroing half a
+    megabyte for each pass cost more than the pass): a flag per index a shape can have (all
+    zero between writes), a row per index, and the indices of a merged table."""
 
     def __init__(self) -> None:
         self.mark = np.zeros(SHAPE_INDEX_LIMIT, np.uint8)
         self.row_of = np.empty(SHAPE_INDEX_LIMIT, np.int32)
+        self.merged = np.empty(SHAPE_INDEX_LIMIT, np.int64)
 
 
 _SCRATCH = _Scratch()
@@ -259,31 +260,39 @@ PAIR_CHUNK = 1 << 12
 def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, entry: int, wanted: np.ndarray,
                  table: ObjectTable, jobs: int) -> None:
     """Apply the SE/SD pairs at ``at`` (each writes prop then prop2; a write to a null
-    property stores nothing) that ``wanted`` takes to ``table``, in one compiled call
-    (csrc/kernels.c pairs_write): over their words, the indices written and each pair
-    decoded (in ranges of pairs on a team of ``jobs`` threads when there are many), the
-    table's rows for them, then over the decoded pairs the writes, in order (threads that
-    each took a range of rows spent nearly as long reading every pair as one thread
-    writing them all). A new index gets a new table, its rows in index order."""
-    scratch, had = _SCRATCH, len(table.index)
-    records, index, values = arrays(  # records: each pair decoded once, by pair_marks for pair_apply
-        (len(at), np.uint64), (had + len(at) + 1, np.int64), ((had + len(at), PROP_LIMIT), np.uint16))
+    property stores nothing) that ``wanted`` takes to ``table``, in compiled passes
+    (csrc/kernels.c pairs_rows, pairs_grow): over their words, the indices written and
+    each pair decoded (in ranges of pairs on a team of ``jobs`` threads when there are
+    many), the table's rows for them, then over the decoded pairs the writes, in order
+    (threads that each took a range of rows spent nearly as long reading every pair as one
+    thread writing them all). A new index gets a new table, its rows in index order, of
+    the size it needs: the second call comes only then."""
+    scratch, had, index = _SCRATCH, len(table.index), table.index
+    if had and not (0 <= index[0] and index[-1] < SHAPE_INDEX_LIMIT):
+        raise ValueError(f"object table indices must lie in 0..{SHAPE_INDEX_LIMIT - 1}")
+    records = empty(len(at), np.uint64)  # each pair decoded once, by pair_marks for pair_apply
     pairs = native.Pairs(address(words), len(words), address(at), len(at), address(_PAIR_FIELDS),
                          None if tables is None else address(tables), entry, address(wanted), address(_SE_NULL),
                          address(records), native.avx2())
     count = threads.parts(len(at), jobs, PAIR_CHUNK)
     tops = np.empty(count, np.int64)
+    lib, old = native.library(), (native.ptr(index, np.int64, (had,)), had,
+                                  native.ptr(table.values, np.uint16, (had, PROP_LIMIT)))
     with threads.team(jobs if count > 1 else 1) as team:
-        rows = native.library().pairs_write(team, byref(pairs), count, address(scratch.mark), address(tops),
-                                            address(scratch.row_of), native.ptr(table.index, np.int64, (had,)), had,
-                                            native.ptr(table.values, np.uint16, (had, PROP_LIMIT)), address(index),
-                                            address(values))
-    if rows < 0:  # the first pair without its SD: range k starts at len(at) * k // count (csrc/kernels.c pair_range)
+        rows = lib.pairs_rows(team, byref(pairs), count, address(scratch.mark), address(tops),
+                              address(scratch.row_of), address(scratch.merged), *old)
+    if rows < 0:
         scratch.mark[:] = 0
+        if rows == -2:
+            raise ValueError("object table indices must be sorted and unique")
+        # the first pair without its SD: range k starts at len(at) * k // count (csrc/kernels.c pair_range)
         bad = [len(at) * k // count - 1 - t for k, t in enumerate(tops.tolist()) if t < 0]
         raise Rend3rError(f"{_where(int(at[bad[0]]))}: an SE word without its SD")
     if rows > had:
-        table.index, table.values = index[:rows], values[:rows]
+        new_index, values = empty(rows, np.int64), empty((rows, PROP_LIMIT), np.uint16)
+        lib.pairs_grow(byref(pairs), address(scratch.mark), address(scratch.row_of), address(scratch.merged), rows,
+                       *old, address(new_index), address(values))
+        table.index, table.values = new_index, values
 
 
 @dataclass(frozen=True)

@@ -48,19 +48,22 @@ class team:  # noqa: N801 (used as a function: with threads.team(jobs) as at)
     pool serves that one, and this one's calls run on this thread alone."""
 
     def __init__(self, jobs: int) -> None:
-        self.jobs, self.at = jobs, None
+        self.jobs, self.opened = jobs, []  # per entry of this object: the team it opened, or None
 
     def __enter__(self) -> int:
         led = getattr(_LED, "team", None)
         if led is not None:
+            self.opened.append(None)
             return led
         at = native.library().team_open(self.jobs - 1)
         if not at:
             raise MemoryError("no memory for a team of threads")
-        self.at = _LED.team = at
+        self.opened.append(at)
+        _LED.team = at
         return at
 
     def __exit__(self, *_: object) -> None:
-        if self.at is not None:
+        at = self.opened.pop()
+        if at is not None:
             _LED.team = None
-            native.library().team_close(self.at)  # without waiting: the last member out frees it
+            native.library().team_close(at)  # without waiting: the last member out frees it

@@ -101,16 +101,16 @@ _LINE = 64
 
 
 def arrays(*specs: tuple[int | tuple[int, ...], np.dtype | type]) -> tuple[np.ndarray, ...]:
-    """Uninitialized C-contiguous arrays of the (shape, dtype) ``specs`` (a shape: an int or
-    a tuple of ints), each starting a cache line apart in one buffer of :func:`empty`: one
+    """Uninitialized C-contiguous arrays of the (shape, dtype) ``specs``, each starting a cache line apart in one buffer of :func:`empty`: one
     buffer to find for a frame set-up's dozen arrays. The buffer is held while any of them
     lives."""
-    offsets, at = [], 0
+    laid, at = [], 0
     for shape, dtype in specs:
-        offsets.append(at)
-        at += -(-(shape if type(shape) is int else math.prod(shape)) * np.dtype(dtype).itemsize // _LINE) * _LINE
+        shape = (int(shape),) if isinstance(shape, (int, np.integer)) else tuple(map(int, shape))
+        laid.append((shape, dtype, at))
+        at += -(-math.prod(shape) * np.dtype(dtype).itemsize // _LINE) * _LINE
     buf, view = empty(max(at, 1), np.uint8), np.ndarray
-    return tuple(view(shape, dtype, buf, offset) for (shape, dtype), offset in zip(specs, offsets))
+    return tuple(view(shape, dtype, buf, offset) for shape, dtype, offset in laid)
 
 
 def kept_bytes() -> int:

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
+from rend3r.emu import workspace
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.processor import Execution, execute
 from rend3r.emu.scene import ObjectTable, Scene
@@ -300,6 +301,36 @@ def test_new_indices_merge_into_the_table_in_index_order():
         table.row(4)
     table.clear()
     assert len(table) == 0
+
+
+def test_a_grown_table_holds_memory_for_its_rows_only():
+    """A table that grew keeps arrays of its own size (a kept buffer at most twice it, as
+    any array of the workspace), not the pass's room for every pair or its decoded pairs:
+    a scene kept for a whole run would hold them."""
+    words = [NR] + [w for i in range(3000) for p in range(8) for w in encode(ShapeSet(i, p, p, i, i))] + [NF]
+    scene = Scene()
+    execute(words, EmuOptions(), scene=scene)
+    t = scene.objects
+    assert len(t) == 3000
+    for a in (t.index, t.values):
+        held = a.base.nbytes if a.base is not None else a.nbytes
+        assert held <= 2 * a.nbytes + workspace.SMALLEST
+
+
+@pytest.mark.parametrize(("index", "message"), [([3, 3, 9], "sorted and unique"), ([9, 3], "sorted and unique"),
+                                                ([-1, 4], "must lie in"), ([4, 1 << 19], "must lie in")])
+def test_a_table_with_bad_indices_is_refused_and_left_as_it_was(index, message):
+    """The compiled writes trust a table's indices: one that is not sorted and unique, or
+    lies outside the indices a shape can have, is refused before anything is written."""
+    table = Scene().objects
+    table.index = np.array(index, np.int64)
+    table.values = np.zeros((len(index), 32), np.uint16)
+    with pytest.raises(ValueError, match=message):
+        execute([NR, *encode(ShapeSet(5, 1, 2, 7, 7)), NF], EmuOptions(clear_on_nr=False), scene=Scene(objects=table))
+    assert table.index.tolist() == index and not table.values.any()
+    after = Scene()  # the marks were cleared: the next write marks only its own index
+    execute([NR, *encode(ShapeSet(5, 1, 2, 7, 7)), NF], EmuOptions(), scene=after)
+    assert after.objects.index.tolist() == [5]
 
 
 @settings(max_examples=300)

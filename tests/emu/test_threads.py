@@ -22,10 +22,12 @@ def test_parts_are_a_few_per_thread_and_never_too_short(n, jobs, smallest, want)
 def test_a_team_is_led_once_per_thread_and_ends_with_its_block():
     """Inside a team this thread leads, calls get the same team; another thread leads its
     own meanwhile (the pool serves the first, so the second's calls run alone). After an
-    error in the block the team ends: the process exits, in a process of its own."""
+    error in the block the team ends, and one team object entered twice closes its team
+    once: the process exits, in a process of its own."""
     with threads.team(2) as outer:
         with threads.team(3) as inner:
             assert inner == outer
+
         seen: list[int] = []
 
         def lead() -> None:
@@ -37,7 +39,9 @@ def test_a_team_is_led_once_per_thread_and_ends_with_its_block():
         other.join()
         assert seen and seen[0] != outer
     code = ("from rend3r.emu import threads\n"
-            "try:\n    with threads.team(2):\n        raise KeyError\nexcept KeyError:\n    pass\n")
+            "try:\n    with threads.team(2):\n        raise KeyError\nexcept KeyError:\n    pass\n"
+            "same = threads.team(2)  # one object entered twice: its outer entry opens and closes the team\n"
+            "for _ in range(100):\n    with same as first, same as again:\n        assert first == again\n")
     subprocess.run([sys.executable, "-c", code], check=True, timeout=30)
 
 

@@ -111,7 +111,8 @@ def test_arrays_share_a_buffer_held_while_any_of_them_lives() -> None:
 
 
 def _arrays_in_one_buffer() -> None:
-    specs = (((BIG // 8, 3), np.float64), (5, np.uint8), (0, np.int32), ((7, 2), np.int64), (BIG, np.uint16))
+    specs = (((BIG // 8, 3), np.float64), (np.int64(5), np.uint8), (0, np.int32), ((7, np.int32(2)), np.int64),
+             (BIG, np.uint16))
     got = workspace.arrays(*specs)
     assert [(a.shape, a.dtype) for a in got] == [((BIG // 8, 3), np.float64), ((5,), np.uint8), ((0,), np.int32),
                                                  ((7, 2), np.int64), ((BIG,), np.uint16)]

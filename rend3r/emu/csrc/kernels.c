@@ -852,19 +852,18 @@ static int64_t mark_rows(const uint8_t *mark, int64_t top, int32_t *row_of, int6
     return r;
 }
 
-/* The pairs p written to an object table of `had` rows (index: sorted, values: PROP_WORDS
- * words a row) in one call (processor.py _write_pairs; Python between these steps cost
- * more than they did at 4,096 shapes): pair_marks over `parts` ranges of the pairs on a
- * team, range k's result into tops[k]; the rows of the indices written merged with the
- * table's (mark_rows); then the writes (pair_apply). When an index is new, the merged
- * table goes to index_out and values_out (room for had + p->n rows and one more index),
- * new rows zero (pair_apply zeroes each as it first writes it: a pair that stores marked
- * every new index); else the writes go to values in place. mark (an index's flag, all
- * zero) and row_of (an index's row) are the caller's, 2^19 entries each: mark is zero
- * again on return unless a range fails. Returns the table's rows, or -1 when a range
- * holds a pair without its SD (tops[k] < 0 tells which; nothing is written). */
-int64_t pairs_write(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, int64_t *tops, int32_t *row_of,
-                    const int64_t *index, int64_t had, uint16_t *values, int64_t *index_out, uint16_t *values_out)
+/* The pairs p to be written to an object table of `had` rows (index: sorted, each below
+ * 2^19; values: PROP_WORDS words a row), the first of two calls (processor.py
+ * _write_pairs): pair_marks over `parts` ranges of the pairs on a team, range k's result
+ * into tops[k]; then the rows of the indices written merged with the table's (mark_rows:
+ * row_of[i] the row of index i, merged the indices in order). When no index is new, the
+ * writes (pair_apply) go to values in place here. mark (an index's flag, all zero),
+ * row_of and merged are the caller's, 2^19 entries each. Returns the merged table's rows:
+ * more than had when an index is new (then pairs_grow writes), mark being zero again
+ * otherwise; -1 when a range holds a pair without its SD (tops[k] < 0 tells which), -2
+ * when index is not strictly increasing: nothing written, the marks left to the caller. */
+int64_t pairs_rows(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, int64_t *tops, int32_t *row_of,
+                   int64_t *merged, const int64_t *index, int64_t had, uint16_t *values)
 {
     pair_marks_team(team, p, parts, mark, tops);
     int64_t top = 0;
@@ -875,22 +874,34 @@ int64_t pairs_write(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, in
     }
     if (top == 0)  /* no pair stores a word */
         return had;
-    for (int64_t i = 0; i < had; i++)
+    for (int64_t i = 0; i < had; i++) {
+        if (i && index[i] <= index[i - 1])
+            return -2;
         mark[index[i]] = 1;
+    }
     top = had && index[had - 1] >= top ? index[had - 1] + 1 : top;
-    int64_t rows = mark_rows(mark, top, row_of, index_out);
+    int64_t rows = mark_rows(mark, top, row_of, merged);
     if (rows == had) {  /* no index is new */
         memset(mark, 0, (size_t)top);
         pair_apply(p, row_of, values, NULL);
-        return rows;
     }
+    return rows;
+}
+
+/* The second call when pairs_rows found a new index: the merged table of `rows` rows
+ * into index_out and values_out, the old rows moved there and each new one zeroed as
+ * pair_apply first writes it (every new index was marked by a pair that stores a word),
+ * then the writes. mark is zero again on return. */
+void pairs_grow(const Pairs *p, uint8_t *mark, const int32_t *row_of, const int64_t *merged, int64_t rows,
+                const int64_t *index, int64_t had, const uint16_t *values, int64_t *index_out, uint16_t *values_out)
+{
+    memcpy(index_out, merged, (size_t)rows * sizeof *merged);
     for (int64_t i = 0; i < had; i++) {  /* the old rows move; the marks left are the new indices' */
         memcpy(values_out + PROP_WORDS * (int64_t)row_of[index[i]], values + PROP_WORDS * i,
                PROP_WORDS * sizeof *values);
         mark[index[i]] = 0;
     }
-    pair_apply(p, row_of, values_out, mark);  /* a pair that stores marked each: every mark goes */
-    return rows;
+    pair_apply(p, row_of, values_out, mark);
 }
 
 /* ---- rounding, for tests ---- */

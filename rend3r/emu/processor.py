@@ -276,6 +276,8 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
                          address(records), native.avx2())
     count = threads.parts(len(at), jobs, PAIR_CHUNK)
     tops = np.empty(count, np.int64)
+    if had and not table.values.flags.writeable:  # the writes may go in place: into a copy of a read-only table
+        table.values = table.values.copy()
     lib, old = native.library(), (native.ptr(index, np.int64, (had,)), had,
                                   native.ptr(table.values, np.uint16, (had, PROP_LIMIT)))
     with threads.team(jobs if count > 1 else 1) as team:

@@ -317,6 +317,18 @@ def test_a_grown_table_holds_memory_for_its_rows_only():
         assert held <= 2 * a.nbytes + workspace.SMALLEST
 
 
+def test_a_read_only_table_is_written_in_a_copy():
+    """A table whose values are read-only (a caller's, say from a file mapped read-only)
+    gets its writes in a copy: the caller's array is never written through."""
+    values = np.zeros((2, 32), np.uint16)
+    values[0, 1] = 5
+    values.flags.writeable = False
+    table = Scene().objects
+    table.index, table.values = np.array([3, 7], np.int64), values
+    execute([*encode(ShapeSet(7, 1, 2, 9, 9)), NF], EmuOptions(), scene=Scene(objects=table))
+    assert values[1].tolist() == [0] * 32 and table.row(7) == {1: 9, 2: 9} and table.row(3) == {1: 5}
+
+
 @pytest.mark.parametrize(("index", "message"), [([3, 3, 9], "sorted and unique"), ([9, 3], "sorted and unique"),
                                                 ([-1, 4], "must lie in"), ([4, 1 << 19], "must lie in")])
 def test_a_table_with_bad_indices_is_refused_and_left_as_it_was(index, message):

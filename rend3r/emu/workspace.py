@@ -72,11 +72,15 @@ def _calibrate() -> int | None:
 _FREE = _calibrate()
 
 
+def _shape(shape: int | tuple[int, ...]) -> tuple[int, ...]:
+    """A shape as a tuple of Python ints (numpy integers accepted)."""
+    return (int(shape),) if isinstance(shape, (int, np.integer)) else tuple(map(int, shape))
+
+
 def empty(shape: int | tuple[int, ...], dtype: np.dtype | type = np.float64) -> np.ndarray:
     """An uninitialized C-contiguous array, as ``np.empty(shape, dtype)`` gives, in the
     smallest free buffer of this thread that holds it (a new one when none does)."""
-    dtype = np.dtype(dtype)
-    shape = (int(shape),) if isinstance(shape, (int, np.integer)) else tuple(map(int, shape))
+    dtype, shape = np.dtype(dtype), _shape(shape)
     need = math.prod(shape) * dtype.itemsize
     if need < SMALLEST or _FREE is None:
         return np.empty(shape, dtype)
@@ -101,12 +105,12 @@ _LINE = 64
 
 
 def arrays(*specs: tuple[int | tuple[int, ...], np.dtype | type]) -> tuple[np.ndarray, ...]:
-    """Uninitialized C-contiguous arrays of the (shape, dtype) ``specs``, each starting a cache line apart in one buffer of :func:`empty`: one
-    buffer to find for a frame set-up's dozen arrays. The buffer is held while any of them
-    lives."""
+    """Uninitialized C-contiguous arrays of the (shape, dtype) ``specs``, each starting a
+    cache line apart in one buffer of :func:`empty`: one buffer to find for a frame
+    set-up's dozen arrays. The buffer is held while any of them lives."""
     laid, at = [], 0
     for shape, dtype in specs:
-        shape = (int(shape),) if isinstance(shape, (int, np.integer)) else tuple(map(int, shape))
+        shape = _shape(shape)
         laid.append((shape, dtype, at))
         at += -(-math.prod(shape) * np.dtype(dtype).itemsize // _LINE) * _LINE
     buf, view = empty(max(at, 1), np.uint8), np.ndarray

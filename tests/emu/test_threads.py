@@ -1,6 +1,7 @@
 """The kernels' threads (threads.py, csrc/team.c): a team per thread that leads one, the
 splits, and the pool's threads across errors and forks."""
 
+import os
 import subprocess
 import sys
 import threading
@@ -94,4 +95,35 @@ def test_a_forked_child_starts_its_own_team_threads():
         "if pid == 0:\n"
         "    os._exit(0 if frame(2).rgb565.tobytes() == one else 1)\n"
         "assert os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]) == 0\n")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=60, cwd=ROOT)
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2,
+                    reason="needs Linux CPU affinity and two CPUs")
+def test_a_member_woken_onto_its_leaders_cpu_moves_to_another():
+    """A scheduler that packs threads onto few CPUs (a VM guest's) may leave the pool's
+    thread on its leader's CPU, where the two take turns: at the next phase the member
+    moves to another of its CPUs (csrc/team.c team_apart). Emulated by pinning every
+    native thread but the leader's to the leader's CPU, in a process of its own; the
+    frames stay the same."""
+    code = (
+        "import os, sys, threading\n"
+        "sys.path.insert(0, 'benchmarks')\n"
+        "import walls\n"
+        "from rend3r.emu.options import EmuOptions\n"
+        "from rend3r.emu.run import run_program\n"
+        "from rend3r.emu import bounds, raytracer\n"
+        "raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK = 16, 8  # every pass split\n"
+        "w = walls.wall(256, 1)\n"
+        "frame = lambda: run_program(w.words, EmuOptions(precision='fp32', jobs=2, width=256, height=192)).frames[0]\n"
+        "want = frame().rgb565.tobytes()\n"
+        "native = [int(t) for t in os.listdir('/proc/self/task')\n"
+        "          if int(t) not in {t.native_id for t in threading.enumerate()}]\n"
+        "cpu = min(os.sched_getaffinity(0))\n"
+        "os.sched_setaffinity(0, {cpu})\n"
+        "for tid in native:\n"
+        "    os.sched_setaffinity(tid, {cpu})\n"
+        "assert all(frame().rgb565.tobytes() == want for _ in range(10))\n"
+        "moved = [tid for tid in native if os.sched_getaffinity(tid) != {cpu}]\n"
+        "assert moved and all(cpu not in os.sched_getaffinity(tid) for tid in moved), moved\n")
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60, cwd=ROOT)

@@ -54,6 +54,7 @@ typedef struct {
     TEAM_ATOMIC(uint64_t) claim;    /* that phase << 32 | its next task not yet taken */
     int64_t phases;                 /* the leader's count of phases */
     TEAM_ATOMIC(int32_t) refs;      /* the leader until it closes the team, and each member inside it */
+    TEAM_ATOMIC(int32_t) leader_cpu;  /* the CPU the leader released its last phase on (-1: not known) */
     TeamPhase ring[TEAM_RING];
 } Team;
 

@@ -10,7 +10,7 @@
  * member's CPU for milliseconds; a close that waited for the member to see the end then
  * took 1.4 ms (median over a slow spell's runs at 4,096 spheres) where it takes 10 us.
  */
-#if defined(__linux__)
+#if defined(__linux__) && !defined(_GNU_SOURCE)
 #define _GNU_SOURCE  /* sched_getcpu and CPU sets (team_apart) */
 #endif
 #define _POSIX_C_SOURCE 200809L  /* pthread_sigmask, sched_yield under -std=c11 */
@@ -83,23 +83,27 @@ static void team_cpus(TeamCpus *c)
 #endif
 }
 
-/* Moves a member that runs on its leader's CPU to its other CPUs, if it has any: a
- * scheduler that packs threads onto few CPUs (a VM guest's, to let its other vCPUs idle)
- * may wake a member onto its leader's CPU and leave it there, where the two take turns
- * and each phase's end waits out a spin (the thread stays apart until the leader comes
- * to its CPU; the next phase then moves it again). */
-static void team_apart(const TeamCpus *c, int32_t leader_cpu)
+/* Moves a member that runs on its leader's CPU to another of its CPUs (c, those it
+ * started with), when the team (size threads) has no more threads than those CPUs: a
+ * scheduler that packs threads onto few CPUs (a VM guest's, to let its other vCPUs
+ * idle) may wake a member onto its leader's CPU and leave it there, where the two take
+ * turns and each phase's end waits out a spin. The member's CPUs are narrowed, which
+ * moves it, then given back at once: it is never left pinned, and the scheduler may
+ * place it anywhere again (the next team's join or phase moves it again if need be). */
+static void team_apart(const TeamCpus *c, int32_t leader_cpu, int32_t size)
 {
 #if defined(__linux__)
-    if (!c->known || leader_cpu < 0 || leader_cpu >= CPU_SETSIZE || team_cpu() != leader_cpu)
+    if (!c->known || leader_cpu < 0 || leader_cpu >= CPU_SETSIZE || size > CPU_COUNT(&c->allowed)
+        || team_cpu() != leader_cpu)
         return;
     cpu_set_t other = c->allowed;
     CPU_CLR(leader_cpu, &other);
-    if (CPU_COUNT(&other) > 0)
-        sched_setaffinity(0, sizeof other, &other);
+    if (CPU_COUNT(&other) > 0 && sched_setaffinity(0, sizeof other, &other) == 0)
+        sched_setaffinity(0, sizeof c->allowed, &c->allowed);
 #else
     (void)c;
     (void)leader_cpu;
+    (void)size;
 #endif
 }
 
@@ -125,13 +129,13 @@ static void team_take(Team *t, int64_t p, TeamPhase *ph)
 static void team_member(Team *t, const TeamCpus *c)
 {
     int64_t done = 0, spins = 0;
-    team_apart(c, atomic_load_explicit(&t->leader_cpu, memory_order_relaxed));
+    team_apart(c, atomic_load_explicit(&t->leader_cpu, memory_order_relaxed), t->size);
     for (;;) {
         int64_t p = atomic_load_explicit(&t->released, memory_order_acquire);
         if (p == TEAM_ENDED)
             return;
         if (p != done) {
-            team_apart(c, atomic_load_explicit(&t->leader_cpu, memory_order_relaxed));
+            team_apart(c, atomic_load_explicit(&t->leader_cpu, memory_order_relaxed), t->size);
             team_take(t, p, &t->ring[p % TEAM_RING]);
             done = p;
             spins = 0;
@@ -250,6 +254,7 @@ Team *team_open(int32_t members)
     }
     pthread_sigmask(SIG_SETMASK, &before, NULL);
     pool.wanted = members < pool.started ? members : pool.started;
+    t->size = 1 + pool.wanted;  /* read by the members after the lock below */
     pool.team = t;
     pool.opened++;
     pthread_cond_broadcast(&pool_wake);

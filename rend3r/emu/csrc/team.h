@@ -55,6 +55,7 @@ typedef struct {
     int64_t phases;                 /* the leader's count of phases */
     TEAM_ATOMIC(int32_t) refs;      /* the leader until it closes the team, and each member inside it */
     TEAM_ATOMIC(int32_t) leader_cpu;  /* the CPU the leader released its last phase on (-1: not known) */
+    int32_t size;                   /* the leader and the members it was opened for */
     TeamPhase ring[TEAM_RING];
 } Team;
 

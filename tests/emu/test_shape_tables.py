@@ -58,6 +58,20 @@ def test_tables_hold_the_values_the_reference_reads(precision, rows, seed, on):
             got, want = np.ascontiguousarray(fr.sf[:, first + k]), np.asarray(want, fr.dtype)
             assert ((bits(got) == bits(want)) | (np.isnan(got) & np.isnan(want))).all()
     assert fr.si[:, native.SI_COLOUR].tolist() == ref.color.astype(np.int64).tolist()
+    # the bound table (bounds.py shape_bounds): |q|^2 times the least and largest |inverse
+    # scale| in double (a NaN scale: both NaN); bounded: a sphere, a finite centre, moderate maps
+    with np.errstate(invalid="ignore"):  # inf * 0 and NaN compare as the kernels' do
+        rot, inv = (np.array(v, np.float64) for v in (ref.rot, ref.inv_scale))
+        q2 = ((rot[0] * rot[0] + rot[1] * rot[1]) + rot[2] * rot[2]) + rot[3] * rot[3]
+        nan = np.isnan(inv).any(axis=0)
+        smin = np.where(nan, np.nan, q2 * np.min(np.abs(inv), axis=0))
+        smax = np.where(nan, np.nan, q2 * np.max(np.abs(inv), axis=0))
+        centre = np.array(ref.loc, np.float64).T
+        for got, want in ((fr.bnd[:, native.B_CENTER:native.B_CENTER + 3], centre), (fr.bnd[:, native.B_SMIN], smin),
+                          (fr.bnd[:, native.B_SMAX], smax)):
+            assert ((bits(np.ascontiguousarray(got)) == bits(want)) | (np.isnan(got) & np.isnan(want))).all()
+        want = (ref.zsign == 1) & np.isfinite(centre).all(axis=1) & (smin >= 0.015625) & (smax <= 64.0)
+    assert fr.bounded.astype(bool).tolist() == want.tolist()
 
 
 @settings(max_examples=30, derandomize=True)

@@ -76,18 +76,23 @@ def test_teams_opened_and_closed_in_quick_succession_on_two_threads():
     subprocess.run([sys.executable, "-c", code], check=True, timeout=120, cwd=ROOT)
 
 
+#: The start of a script run in a process of its own: the 256-sphere wall ``w``, every pass
+#: of its frames split over the team.
+_SPLIT_WALL = (
+    "import os, sys\n"
+    "sys.path.insert(0, 'benchmarks')\n"
+    "import walls\n"
+    "from rend3r.emu.options import EmuOptions\n"
+    "from rend3r.emu.run import run_program\n"
+    "from rend3r.emu import bounds, raytracer\n"
+    "raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK = 16, 8  # every pass split\n"
+    "w = walls.wall(256, 1)\n")
+
+
 def test_a_forked_child_starts_its_own_team_threads():
     """The pool's threads do not survive a fork: a child that renders with two jobs starts
     its own, and gets the frames its parent gets with one."""
-    code = (
-        "import os, sys\n"
-        "sys.path.insert(0, 'benchmarks')\n"
-        "import walls\n"
-        "from rend3r.emu.options import EmuOptions\n"
-        "from rend3r.emu.run import run_program\n"
-        "from rend3r.emu import bounds, raytracer\n"
-        "raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK = 16, 8  # every pass split\n"
-        "w = walls.wall(256, 1)\n"
+    code = _SPLIT_WALL + (
         "frame = lambda j: run_program(w.words, EmuOptions(precision='fp32', jobs=j, width=64, height=48)).frames[0]\n"
         "one = frame(1).rgb565.tobytes()\n"
         "assert frame(2).rgb565.tobytes() == one\n"
@@ -107,15 +112,8 @@ def test_a_member_woken_onto_its_leaders_cpu_moves_to_another():
     team_apart). Emulated by pinning every native thread to the leader's CPU, in a
     process of its own (the pool's thread restores the CPUs it started with); the frames
     stay the same."""
-    code = (
-        "import os, sys, threading\n"
-        "sys.path.insert(0, 'benchmarks')\n"
-        "import walls\n"
-        "from rend3r.emu.options import EmuOptions\n"
-        "from rend3r.emu.run import run_program\n"
-        "from rend3r.emu import bounds, raytracer\n"
-        "raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK = 16, 8  # every pass split\n"
-        "w = walls.wall(256, 1)\n"
+    code = _SPLIT_WALL + (
+        "import threading\n"
         "frame = lambda: run_program(w.words, EmuOptions(precision='fp32', jobs=2, width=256, height=192)).frames[0]\n"
         "want = frame().rgb565.tobytes()\n"
         "native = [int(t) for t in os.listdir('/proc/self/task')\n"

@@ -39,7 +39,8 @@ def test_tables_hold_the_values_the_reference_reads(precision, rows, seed, on):
     rng = np.random.default_rng(seed)
     scene = Scene()
     values = rng.integers(0, 1 << 16, size=(rows, PROP_LIMIT), dtype=np.uint16)
-    values[rng.random((rows, PROP_LIMIT)) < 0.3] = rng.choice(EDGES)
+    edge = rng.random((rows, PROP_LIMIT)) < 0.3
+    values[edge] = rng.choice(EDGES, size=int(edge.sum()))  # each its own edge pattern
     p = {n: prop_index(Table.SHAPE, n) for n in _NAMES + ("type",)}
     values[:, p["type"]] = np.where(rng.random(rows) < on, rng.choice([1, 2, 3], size=rows),
                                     rng.choice([0, 4, 7], size=rows))  # sphere, cylinder, cone; off

@@ -107,18 +107,27 @@ static void team_apart(const TeamCpus *c, int32_t leader_cpu, int32_t size)
 #endif
 }
 
+/* A phase's claim word: its number << 32, the first task not taken from the front << 16,
+ * and one past the last not taken from the back (at most TEAM_TASKS). */
+#define TEAM_TASKS 0xFFFF
+#define CLAIM_FRONT(v) ((int64_t)((v) >> 16 & TEAM_TASKS))
+#define CLAIM_BACK(v) ((int64_t)((v) & TEAM_TASKS))
+
 /* Takes tasks of phase p (its slot ph, read after p was seen released) until none is
- * left or the phase is over. */
-static void team_take(Team *t, int64_t p, TeamPhase *ph)
+ * left or the phase is over: the leader from the front, members from the back, so that a
+ * team of two keeps each end of a pass's ranges on the same thread from pass to pass
+ * (measured in a throwaway build over ten alternating pairs of runs: 1.82x against 1.77x
+ * at 4,096 spheres with one counter for all). */
+static void team_take(Team *t, int64_t p, TeamPhase *ph, int from_back)
 {
     TeamTask fn = ph->fn;
     void *ctx = ph->ctx;
-    int64_t tasks = ph->tasks;
     uint64_t v = atomic_load_explicit(&t->claim, memory_order_acquire);
-    while ((int64_t)(v >> 32) == p && (int64_t)(v & 0xFFFFFFFFu) < tasks) {
-        if (atomic_compare_exchange_weak_explicit(&t->claim, &v, v + 1, memory_order_acq_rel,
+    while ((int64_t)(v >> 32) == p && CLAIM_FRONT(v) < CLAIM_BACK(v)) {
+        uint64_t next = from_back ? v - 1 : v + (1u << 16);
+        if (atomic_compare_exchange_weak_explicit(&t->claim, &v, next, memory_order_acq_rel,
                                                   memory_order_acquire)) {
-            fn(ctx, (int64_t)(v & 0xFFFFFFFFu));
+            fn(ctx, from_back ? CLAIM_BACK(v) - 1 : CLAIM_FRONT(v));
             atomic_fetch_add_explicit(&ph->finished, 1, memory_order_release);
             v = atomic_load_explicit(&t->claim, memory_order_acquire);
         }
@@ -136,7 +145,7 @@ static void team_member(Team *t, const TeamCpus *c)
             return;
         if (p != done) {
             team_apart(c, atomic_load_explicit(&t->leader_cpu, memory_order_relaxed), t->size);
-            team_take(t, p, &t->ring[p % TEAM_RING]);
+            team_take(t, p, &t->ring[p % TEAM_RING], 1);
             done = p;
             spins = 0;
         } else {
@@ -147,7 +156,7 @@ static void team_member(Team *t, const TeamCpus *c)
 
 void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
 {
-    if (tasks <= 1) {  /* nothing to share */
+    if (tasks <= 1 || tasks > TEAM_TASKS) {  /* nothing to share, or more than a claim counts (no pass asks) */
         for (int64_t k = 0; k < tasks; k++)
             fn(ctx, k);
         return;
@@ -159,9 +168,9 @@ void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
     ph->tasks = tasks;
     atomic_store_explicit(&ph->finished, 0, memory_order_relaxed);
     atomic_store_explicit(&t->leader_cpu, team_cpu(), memory_order_relaxed);
-    atomic_store_explicit(&t->claim, (uint64_t)p << 32, memory_order_release);
+    atomic_store_explicit(&t->claim, (uint64_t)p << 32 | (uint64_t)tasks, memory_order_release);
     atomic_store_explicit(&t->released, p, memory_order_release);
-    team_take(t, p, ph);
+    team_take(t, p, ph, 0);
     int64_t spins = 0;
     while (atomic_load_explicit(&ph->finished, memory_order_acquire) < tasks)
         team_wait(&spins);

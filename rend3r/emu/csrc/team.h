@@ -6,7 +6,8 @@
  * one open while a program runs): it releases phases one after another, each a list of
  * tasks, takes tasks itself and waits until every task of the phase has finished. The
  * members are native threads of a pool (team.c), which wait spinning for the next phase
- * and take the next task not yet taken of the phase released last. A member may join
+ * and take tasks of the phase released last: the leader from the front of its list, the
+ * members from the back, each the next one not yet taken. A member may join
  * late or never: the leader never waits for one to arrive, only for the tasks taken to
  * finish. Tasks write disjoint outputs, so results never depend on which thread ran which
  * task.
@@ -51,7 +52,7 @@ typedef struct {
 
 typedef struct {
     TEAM_ATOMIC(int64_t) released;  /* the phase released last (1, 2, ...; 0: none yet), TEAM_ENDED once ended */
-    TEAM_ATOMIC(uint64_t) claim;    /* that phase << 32 | its next task not yet taken */
+    TEAM_ATOMIC(uint64_t) claim;    /* that phase << 32 | its first task not taken << 16 | one past its last (team.c) */
     int64_t phases;                 /* the leader's count of phases */
     TEAM_ATOMIC(int32_t) refs;      /* the leader until it closes the team, and each member inside it */
     TEAM_ATOMIC(int32_t) leader_cpu;  /* the CPU the leader released its last phase on (-1: not known) */

@@ -7,7 +7,8 @@ way whatever the split, so results never depend on the thread count.
 The work runs on a :func:`team`: the calling thread leads it and takes part, and native
 threads of the kernels' pool join it and wait spinning between the compiled calls
 (``csrc/team.h``), so that a pass of a few tens of microseconds still splits; each thread
-takes the next range not yet taken. (A caller that only waited while ``jobs`` helpers
+takes the next range not yet taken (the caller from the front, the pool's threads from
+the back). (A caller that only waited while ``jobs`` helpers
 worked left its core idle, and Linux woke the helpers onto one core: measured here, the
 two helpers of a 65,536-sphere frame took turns on one CPU while the other idled.)
 """

@@ -39,9 +39,12 @@ typedef struct {
 } Chunks;
 
 /* Where part k of 0..n starts when the parts shrink from 1.75 times their mean size to a
- * quarter of it (n (x + 3/4 x (1 - x)) at x = k / parts): threads take parts in order, so
- * the last ones taken are short and the threads end a pass close together, where equal
- * parts left one waiting up to a part's time at the end of each pass. */
+ * quarter of it (n (x + 3/4 x (1 - x)) at x = k / parts): made for threads taking parts
+ * in order, so that the last ones taken are short and the threads end a pass close
+ * together, where equal parts left one waiting up to a part's time at the end of each
+ * pass. Since the leader takes from the front and the members from the back (team.c
+ * team_take), the parts met last are mid-sized; parts shrinking towards where the two
+ * ends meet are not tried yet. */
 static inline int64_t taper(int64_t n, int64_t parts, int64_t k)
 {
     return (4 * n * k * parts + 3 * n * k * (parts - k)) / (4 * parts * parts);

@@ -13,7 +13,8 @@
  * task.
  *
  * A task is claimed by one compare-and-swap on claim, which holds the phase number with
- * the next task: a member that read a phase's slot late (the leader has moved on and may
+ * the first and last tasks not yet taken (the leader takes from the front, the members
+ * from the back): a member that read a phase's slot late (the leader has moved on and may
  * be rewriting it) fails that swap, as the phase number in claim has changed, and never
  * runs a task of a phase that is over. A phase's slot is rewritten TEAM_RING phases
  * later, when every task of it has finished (the leader waited for them).

@@ -73,6 +73,8 @@ def test_tables_hold_the_values_the_reference_reads(precision, rows, seed, on):
             assert ((bits(np.ascontiguousarray(got)) == bits(want)) | (np.isnan(got) & np.isnan(want))).all()
         want = (ref.zsign == 1) & np.isfinite(centre).all(axis=1) & (smin >= 0.015625) & (smax <= 64.0)
     assert fr.bounded.astype(bool).tolist() == want.tolist()
+    ident = (rot[0] == 1) & ((rot[1:] == 0) & ~np.signbit(rot[1:])).all(axis=0)  # the quaternion (1, +0, +0, +0)
+    assert fr.si[:, native.SI_IDENT].astype(bool).tolist() == ident.tolist()
 
 
 @settings(max_examples=30, derandomize=True)

@@ -7,9 +7,10 @@ import sys
 import threading
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from rend3r.emu import threads
+from rend3r.emu import native, threads
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -127,3 +128,24 @@ def test_a_member_woken_onto_its_leaders_cpu_moves_to_another():
         "moved = [tid for tid in native if os.sched_getaffinity(tid) == cpus]  # moved, then given its CPUs back\n"
         "assert moved, [os.sched_getaffinity(tid) for tid in native]\n")
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60, cwd=ROOT)
+
+
+@pytest.mark.parametrize("jobs", [2, 3, 8])
+def test_every_task_of_every_phase_runs_once_on_a_team(jobs):
+    """The claims (csrc/team.c team_take): thousands of phases released back to back on a
+    team, the leader taking tasks from the front and the members from the back, every
+    count a phase may have (none, one, a few, as many as a claim holds, one more, which
+    the leader runs alone), the ring of phase slots reused all the while; each task runs
+    exactly once. Repeated until the members have taken tasks, so that the claims were
+    contended."""
+    lib = native.library()
+    pattern = [0, 1, 2, 3, 5, 7, 16, 64, 2, 1, 2, 3]
+    tasks = np.array(pattern * 500 + [0xFFFF, 0x10000] + pattern * 500, dtype=np.int64)
+    for _ in range(20):
+        runs = np.zeros(int(tasks.sum()), dtype=np.int32)
+        with threads.team(jobs) as at:
+            by_members = lib.team_count(at, native.address(tasks), len(tasks), native.address(runs))
+        np.testing.assert_array_equal(runs, 1)
+        if by_members:
+            break
+    assert 0 < by_members < len(runs), "the pool's threads never took a task"

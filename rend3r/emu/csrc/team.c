@@ -285,3 +285,46 @@ void team_close(Team *t)
     team_release(t);
 }
 #endif
+
+/* ---- a check of the protocol for tests (tests/emu/test_threads.py) ---- */
+
+static _Thread_local char team_here;  /* its address tells the threads apart */
+
+typedef struct {
+    TEAM_ATOMIC(int32_t) *runs;   /* one count per task of this phase */
+    const char *leader;           /* the leader's team_here */
+    TEAM_ATOMIC(int64_t) *by_members;
+} TeamCount;
+
+static void team_count_task(void *ctx, int64_t k)
+{
+    TeamCount *c = ctx;
+    for (volatile int32_t spin = 0; spin < 200; spin++)  /* a little work, so that members get some */
+        ;
+#if TEAM_SOLO
+    c->runs[k]++;
+    *c->by_members += &team_here != c->leader;
+#else
+    atomic_fetch_add_explicit(&c->runs[k], 1, memory_order_relaxed);
+    if (&team_here != c->leader)
+        atomic_fetch_add_explicit(c->by_members, 1, memory_order_relaxed);
+#endif
+}
+
+/* Runs phases of tasks[0], tasks[1], ... tasks on team t, each task adding one to its
+ * count in runs (the phases' counts one after another); returns how many tasks threads
+ * other than the leader ran. */
+int64_t team_count(Team *t, const int64_t *tasks, int64_t phases, int32_t *runs)
+{
+    TEAM_ATOMIC(int64_t) by_members = 0;
+    TeamCount c = {.leader = &team_here, .by_members = &by_members};
+    for (int64_t p = 0, at = 0; p < phases; at += tasks[p++]) {
+        c.runs = (TEAM_ATOMIC(int32_t) *)(runs + at);
+        team_phase(t, team_count_task, &c, tasks[p]);
+    }
+#if TEAM_SOLO
+    return by_members;
+#else
+    return atomic_load(&by_members);
+#endif
+}

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import placement
 import walls
 from bench_raytrace import calibration_us
 from peer_mitsuba import VARIANTS, render_spheres
@@ -233,18 +234,21 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
     jobs=1 frames run 20-30% slow while the idle second vCPU wakes) and one timed. The
     ratio is the median of the rounds' ratios. Each round then measures the two CPUs'
     ceiling (two_cpus.py); the share of it reached is the median of the rounds' ratio over
-    their ceiling."""
+    their ceiling. And where the host had put the two CPUs (placement.py): the rounds of
+    each placement and their median ratio are printed, so that a miss can be told apart
+    from a placement that costs a split frame what it does not cost two processes."""
     if len(cpus) < 2:
         line = f"jobs=2 vs jobs=1: not measured (this process may use {len(cpus)} CPU)"
         print(line)
         return [line]
     lines = []
+    unplaced = placement.available()
     for size in (JOBS_SIZE, JOBS_ALSO):
         wall = walls.wall(size, lights=1)
         for precision in ("fp32", "fp16"):
             options = {jobs: EmuOptions(precision=precision, width=WIDTH, height=HEIGHT, jobs=jobs) for jobs in (1, 2)}
             times: dict[int, list[float]] = {1: [], 2: []}
-            ceilings = []
+            ceilings, placed = [], []
             with TwoCpus(cpus, size, precision, WIDTH, HEIGHT, WARM_FRAMES) as two:
                 for _ in range(max(runs, JOBS_ROUNDS)):
                     for jobs, options_ in options.items():
@@ -254,6 +258,8 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
                         run_program(wall.words, options_)
                         times[jobs].append(time.perf_counter() - start)
                     ceilings.append(two.ceiling())
+                    if unplaced is None:
+                        placed.append(placement.measure(cpus))
             ratios = [a / b for a, b in zip(times[1], times[2])]
             ratio = statistics.median(ratios)
             share = statistics.median(r / c for r, c in zip(ratios, ceilings))
@@ -265,9 +271,24 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
                          f"{statistics.median(times[2]):.4f} s: {ratio:.2f}x faster (quartiles of the rounds "
                          f"{low:.2f}-{high:.2f}x) {target}; two pinned "
                          f"processes in the same rounds render {statistics.median(ceilings):.2f}x the frames of one "
-                         f"(two_cpus.py), jobs=2 reaches {share:.0%} of that")
+                         f"(two_cpus.py), jobs=2 reaches {share:.0%} of that; {_placements(placed, ratios, unplaced)}")
             print(lines[-1], flush=True)
     return lines
+
+
+def _placements(placed: list[placement.Placement], ratios: list[float], unplaced: str | None) -> str:
+    """Where the host had put the two CPUs in the rounds (placement.py): per placement, its
+    rounds, the median time of a line read across the CPUs and the rounds' median ratio."""
+    if unplaced is not None:
+        return f"the CPUs' placement not measured ({unplaced})"
+    parts = []
+    for kind in placement.KINDS:
+        mine = [(p, r) for p, r in zip(placed, ratios) if p.kind == kind]
+        if mine:
+            parts.append(f"{len(mine)} rounds on {kind} (a line read across in "
+                         f"{statistics.median(p.cross_ns for p, _ in mine):.0f} ns): "
+                         f"{statistics.median(r for _, r in mine):.2f}x")
+    return "the host placed the two CPUs (placement.py): " + ", ".join(parts)
 
 
 def _table(head: list[str], align: list[str], body: list[list[str]]) -> list[str]:

@@ -1,0 +1,39 @@
+"""bench_peer.py's measure of where the host put two CPUs (placement.py, placement.c)."""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+import placement
+
+WHY = placement.available()
+
+
+@pytest.mark.parametrize(("cross", "own", "kind"), [
+    (4.2, 4.1, "one core"), (7.9, 4.0, "one core"), (8.0, 4.0, "shared L3"), (19.0, 5.0, "shared L3"),
+    (32.0, 4.0, "separate L3s"), (85.0, 5.0, "separate L3s")])
+def test_the_kind_follows_the_ratio_of_the_reads(cross, own, kind):
+    assert placement.Placement(cross, own).kind == kind
+
+
+@pytest.mark.skipif(WHY is not None, reason=f"placement not measured: {WHY}")
+def test_two_cpus_are_measured_and_placed():
+    p = placement.measure(os.sched_getaffinity(0), rounds=2)
+    assert all(math.isfinite(x) and 0 < x < 10_000 for x in (p.cross_ns, p.own_ns))
+    assert p.kind in placement.KINDS
+
+
+@pytest.mark.skipif(WHY is not None, reason=f"placement not measured: {WHY}")
+def test_a_cpu_it_may_not_use_and_a_bad_count_are_refused():
+    cpu = min(os.sched_getaffinity(0))
+    with pytest.raises(RuntimeError, match="could not be used"):
+        placement.measure({cpu, 1000})  # not a CPU of this machine
+    for rounds in (0, 65):
+        with pytest.raises(ValueError, match="outside 1..64"):
+            placement.measure(os.sched_getaffinity(0), rounds)

@@ -234,8 +234,9 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
     jobs=1 frames run 20-30% slow while the idle second vCPU wakes) and one timed. The
     ratio is the median of the rounds' ratios. Each round then measures the two CPUs'
     ceiling (two_cpus.py); the share of it reached is the median of the rounds' ratio over
-    their ceiling. And where the host had put the two CPUs (placement.py): the rounds of
-    each placement and their median ratio are printed, so that a miss can be told apart
+    their ceiling. And where the host had put the two CPUs (placement.py), probed before
+    and after each round's frames: the rounds of each placement (``moved`` when the two
+    probes differ) and their median ratio are printed, so that a miss can be told apart
     from a placement that costs a split frame what it does not cost two processes."""
     if len(cpus) < 2:
         line = f"jobs=2 vs jobs=1: not measured (this process may use {len(cpus)} CPU)"
@@ -251,15 +252,16 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
             ceilings, placed = [], []
             with TwoCpus(cpus, size, precision, WIDTH, HEIGHT, WARM_FRAMES) as two:
                 for _ in range(max(runs, JOBS_ROUNDS)):
+                    before = _placed(cpus, unplaced)
                     for jobs, options_ in options.items():
                         for _ in range(WARM_FRAMES):
                             run_program(wall.words, options_)
                         start = time.perf_counter()
                         run_program(wall.words, options_)
                         times[jobs].append(time.perf_counter() - start)
+                    after = _placed(cpus, unplaced)
+                    placed.append(after if before and after and before.kind == after.kind else None)
                     ceilings.append(two.ceiling())
-                    if unplaced is None:
-                        placed.append(placement.measure(cpus))
             ratios = [a / b for a, b in zip(times[1], times[2])]
             ratio = statistics.median(ratios)
             share = statistics.median(r / c for r, c in zip(ratios, ceilings))
@@ -276,19 +278,35 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
     return lines
 
 
-def _placements(placed: list[placement.Placement], ratios: list[float], unplaced: str | None) -> str:
+def _placed(cpus: set[int], unplaced: str | None) -> placement.Placement | None:
+    """Where the host has put the two CPUs now (placement.py), None when it cannot be
+    measured."""
+    if unplaced is not None:
+        return None
+    try:
+        return placement.measure(cpus)
+    except RuntimeError:
+        return None
+
+
+def _placements(placed: list[placement.Placement | None], ratios: list[float], unplaced: str | None) -> str:
     """Where the host had put the two CPUs in the rounds (placement.py): per placement, its
-    rounds, the median time of a line read across the CPUs and the rounds' median ratio."""
+    rounds, the median time of a line read across the CPUs and the rounds' median ratio;
+    then the rounds in which the CPUs moved (or a probe failed)."""
     if unplaced is not None:
         return f"the CPUs' placement not measured ({unplaced})"
     parts = []
     for kind in placement.KINDS:
-        mine = [(p, r) for p, r in zip(placed, ratios) if p.kind == kind]
+        mine = [(p, r) for p, r in zip(placed, ratios) if p is not None and p.kind == kind]
         if mine:
             parts.append(f"{len(mine)} rounds on {kind} (a line read across in "
                          f"{statistics.median(p.cross_ns for p, _ in mine):.0f} ns): "
                          f"{statistics.median(r for _, r in mine):.2f}x")
-    return "the host placed the two CPUs (placement.py): " + ", ".join(parts)
+    moved = [r for p, r in zip(placed, ratios) if p is None]
+    if moved:
+        parts.append(f"{len(moved)} rounds moved between placements: {statistics.median(moved):.2f}x")
+    return "the host placed the two CPUs (placement.py, probed before and after each round's frames): " + \
+        ", ".join(parts)
 
 
 def _table(head: list[str], align: list[str], body: list[list[str]]) -> list[str]:

@@ -12,8 +12,8 @@
 #include <stdlib.h>
 #include <time.h>
 
-#define LINES 4096   /* 256 KiB: within any L2 of interest */
-#define ROUNDS 64    /* the most rounds a call takes */
+#define LINES 2048   /* 128 KiB: within the L2 of current x86 cores */
+#define ROUNDS 63    /* the most rounds a call takes */
 #define STRIDE 8     /* int64 words per 64-byte line */
 
 typedef struct {
@@ -51,11 +51,20 @@ static double follow(const int64_t *chain, volatile int64_t *sink)
     return now() - start;
 }
 
+/* Waits a little in a spin: on one core's two hardware threads, the other thread's
+ * timed read keeps the core's units. */
+static inline void relax(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+}
+
 /* Writes the chain: a cycle through every line in a fixed shuffled order, so that no
  * prefetcher guesses the next line. */
 static void write_chain(int64_t *chain)
 {
-    static int32_t order[LINES];
+    int32_t order[LINES];
     uint64_t seed = 0x9E3779B97F4A7C15u;
     for (int32_t i = 0; i < LINES; i++)
         order[i] = i;
@@ -81,7 +90,7 @@ static void *writer(void *arg)
         write_chain(p->chain);  /* the lines modified in this CPU's cache again */
         atomic_store(&p->turn, 2 * r + 1);
         while (atomic_load(&p->turn) != 2 * r + 2 && !atomic_load(&p->failed))
-            ;
+            relax();
     }
     return NULL;
 }
@@ -94,7 +103,7 @@ static void *reader(void *arg)
         atomic_store(&p->failed, 1);
     for (int32_t r = 0; r < p->rounds && !atomic_load(&p->failed); r++) {
         while (atomic_load(&p->turn) != 2 * r + 1 && !atomic_load(&p->failed))
-            ;
+            relax();
         p->cross[r] = follow(p->chain, &sink);
         atomic_store(&p->turn, 2 * r + 2);
     }
@@ -107,13 +116,14 @@ static int by_value(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Over `rounds` rounds (1..ROUNDS): the median ns per line of reading, on CPU `to`, lines
- * just written on CPU `from` (out[0]), and of reading them on `from` itself (out[1]).
- * Returns 0, or -1 when the threads could not start or be pinned. The calling thread's
- * CPUs are left as they were. */
+/* Over `rounds` rounds (an odd number, 1..ROUNDS): the median ns per line of reading, on
+ * CPU `to`, lines just written on CPU `from` (out[0]), and of reading them on `from`
+ * itself (out[1]). Returns 0, or -1 when the arguments are not such or the threads could
+ * not start or be pinned. The calling thread's CPUs are left as they were. */
 int32_t cross_read_ns(int32_t from, int32_t to, int32_t rounds, double *out)
 {
-    if (rounds < 1 || rounds > ROUNDS || from < 0 || to < 0 || from >= CPU_SETSIZE || to >= CPU_SETSIZE)
+    if (rounds < 1 || rounds > ROUNDS || rounds % 2 == 0 || from < 0 || to < 0 || from >= CPU_SETSIZE
+        || to >= CPU_SETSIZE || from == to)
         return -1;
     Probe *p = calloc(1, sizeof *p);
     int64_t *chain = aligned_alloc(64, (size_t)LINES * STRIDE * sizeof *chain);

@@ -7,8 +7,7 @@ seconds to minutes between three placements, which a split frame feels and two p
 processes (two_cpus.py) mostly do not:
 
 - ``one core``: the two hardware threads of one core (a shared L2: the other CPU's lines
-  read about as fast as its own). Both CPUs then run slower; ``--jobs 2`` measured 1.12x
-  and two processes about as little.
+  read about as fast as its own). Both CPUs then run slower; ``--jobs 2`` measured 1.12x.
 - ``shared L3``: two cores of one L3 (some 20 ns a line against 5). ``--jobs 2`` measured
   1.80x.
 - ``separate L3s``: the lines cross between L3s (some 85 ns a line). Two processes
@@ -17,9 +16,11 @@ processes (two_cpus.py) mostly do not:
 
 (Medians over 8,393 rounds of three frames each way at 4,096 spheres, fp32, 2026-12-04;
 docs/performance.md.) The kinds are told apart by the ratio of the two reads, so that
-they do not depend on this machine's clock.
+they do not depend on this machine's clock; the cuts between them are set from this
+EPYC's figures (ratios of about 1-1.8, 2.4-5.3 and 9.6-23), and another design (a mesh
+of cores sharing one L3, say) may need others.
 
-    python benchmarks/placement.py [--rounds 10]
+    python benchmarks/placement.py [--measures 10]
 """
 
 from __future__ import annotations
@@ -38,8 +39,9 @@ from pathlib import Path
 
 SOURCE = Path(__file__).with_suffix(".c")
 #: Cross-CPU read time over the writer's own read time: below ONE_CORE the CPUs share an L2,
-#: below SHARED_L3 an L3, else neither (measured here: about 1.4, 3.5 and 17).
-ONE_CORE, SHARED_L3 = 2.0, 8.0
+#: below SHARED_L3 an L3, else neither (each cut near the geometric middle of the ranges
+#: measured on either side of it here).
+ONE_CORE, SHARED_L3 = 2.0, 7.0
 KINDS = ("one core", "shared L3", "separate L3s")
 
 
@@ -59,19 +61,22 @@ class Placement:
 
 @lru_cache(maxsize=1)
 def _library() -> ctypes.CDLL | None:
-    """placement.c compiled with the C compiler Python was built with (or cc), None when
-    there is none."""
-    compiler = (sysconfig.get_config_var("CC") or "cc").split()[0]
-    if shutil.which(compiler) is None:
+    """placement.c compiled with the C compiler Python was built with, else cc; None when
+    neither is found or the build or its loading fails."""
+    configured = (sysconfig.get_config_var("CC") or "").split()[:1]
+    compiler = next((c for c in [*configured, "cc"] if shutil.which(c)), None)
+    if compiler is None:
         return None
-    folder = Path(tempfile.mkdtemp(prefix="rend3r-placement-"))
-    out = folder / "placement.so"
-    subprocess.run([compiler, "-std=c11", "-O2", "-shared", "-fPIC", "-pthread", str(SOURCE), "-o", str(out)],
-                   check=True, capture_output=True)
-    lib = ctypes.CDLL(str(out))
+    with tempfile.TemporaryDirectory(prefix="rend3r-placement-") as folder:
+        out = Path(folder) / "placement.so"
+        try:
+            subprocess.run([compiler, "-std=c11", "-O2", "-shared", "-fPIC", "-pthread", str(SOURCE), "-o", str(out)],
+                           check=True, capture_output=True)
+            lib = ctypes.CDLL(str(out))  # loaded: the file may go with its folder
+        except (OSError, subprocess.CalledProcessError):
+            return None
     lib.cross_read_ns.restype = ctypes.c_int32
     lib.cross_read_ns.argtypes = [ctypes.c_int32, ctypes.c_int32, ctypes.c_int32, ctypes.POINTER(ctypes.c_double)]
-    shutil.rmtree(folder)  # loaded: the file may go
     return lib
 
 
@@ -82,17 +87,20 @@ def available() -> str | None:
     if len(os.sched_getaffinity(0)) < 2:
         return "needs two CPUs"
     if _library() is None:
-        return "needs a C compiler to build benchmarks/placement.c"
+        return "needs a C compiler that builds and loads benchmarks/placement.c"
     return None
 
 
-def measure(cpus: set[int], rounds: int = 4) -> Placement:
-    """The placement of the first two of ``cpus``: the medians over ``rounds`` rounds
-    (1..64) each way, averaged over the two ways. RuntimeError when a CPU cannot be used."""
-    if not 1 <= rounds <= 64:
-        raise ValueError(f"rounds {rounds} is outside 1..64")
+def measure(cpus: set[int], rounds: int = 5) -> Placement:
+    """The placement of the first two of ``cpus``: the medians over ``rounds`` rounds (an
+    odd number, 1..63) each way, averaged over the two ways. RuntimeError when it cannot
+    be measured (a CPU cannot be used, or no compiler)."""
+    if not (1 <= rounds <= 63 and rounds % 2):
+        raise ValueError(f"rounds {rounds} is not an odd number in 1..63")
+    if len(cpus) < 2:
+        raise RuntimeError(f"placement not measured: two CPUs needed, {len(cpus)} given")
     lib = _library()
-    if lib is None or len(cpus) < 2:
+    if lib is None:
         raise RuntimeError(f"placement not measured: {available()}")
     a, b = sorted(cpus)[:2]
     out = (ctypes.c_double * 2)()
@@ -107,19 +115,19 @@ def measure(cpus: set[int], rounds: int = 4) -> Placement:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--rounds", type=int, default=10, help="measures, one a second")
+    ap.add_argument("--measures", type=int, default=10, help="how many, one a second")
     args = ap.parse_args()
-    if args.rounds < 1:
-        ap.error(f"--rounds {args.rounds}: at least 1")
+    if args.measures < 1:
+        ap.error(f"--measures {args.measures}: at least 1")
     why = available()
     if why:
         print(f"not measured: {why}")
         return 0
-    for k in range(args.rounds):
+    for k in range(args.measures):
         p = measure(os.sched_getaffinity(0))
         print(f"{p.kind:>12}: a line written on the other CPU read in {p.cross_ns:5.1f} ns, "
               f"one of its own in {p.own_ns:4.1f} ns", flush=True)
-        if k + 1 < args.rounds:
+        if k + 1 < args.measures:
             time.sleep(1)
     return 0
 

@@ -7,10 +7,9 @@ import sys
 import threading
 from pathlib import Path
 
-import numpy as np
 import pytest
 
-from rend3r.emu import native, threads
+from rend3r.emu import threads
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -130,22 +129,42 @@ def test_a_member_woken_onto_its_leaders_cpu_moves_to_another():
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60, cwd=ROOT)
 
 
+#: Runs thousands of phases on a team of sys.argv[1] threads through the test-only
+#: team_check_runs (csrc/team.c) until members have taken tasks in a hundred small phases,
+#: checking every round that each task ran once and that members ran none of a phase the
+#: leader runs alone.
+_CHECK_RUNS = """
+import sys
+import numpy as np
+from rend3r.emu import native, threads
+lib = native.library()
+pattern = [0, 1, 2, 3, 5, 7, 16, 64, 2, 1, 2, 3]
+tasks = np.array(pattern * 500 + [0xFFFF, 0x10000] + pattern * 500, dtype=np.int64)
+phase_of = np.repeat(np.arange(len(tasks)), tasks)
+alone = (tasks <= 1) | (tasks > 0xFFFF)
+contended = 0
+for _ in range(50):
+    runs = np.zeros(int(tasks.sum()), dtype=np.int32)
+    with threads.team(int(sys.argv[1])) as at:
+        lib.team_check_runs(at, native.address(tasks), len(tasks), native.address(runs))
+    wrong = np.flatnonzero(runs % 256 != 1)
+    assert not len(wrong), f"task {wrong[0]} of the list ran {runs[wrong[0]] % 256} times"
+    by_member = runs >= 256
+    assert not by_member[alone[phase_of]].any(), "a member ran a task of a phase the leader runs alone"
+    contended += len(np.unique(phase_of[by_member & (tasks[phase_of] <= 64)]))
+    if contended >= 100:
+        break
+assert contended >= 100, f"members took tasks in only {contended} small phases"
+"""
+
+
+@pytest.mark.skipif(threads.available_cores() < 2, reason="needs two CPUs for the members to contend")
 @pytest.mark.parametrize("jobs", [2, 3, 8])
 def test_every_task_of_every_phase_runs_once_on_a_team(jobs):
     """The claims (csrc/team.c team_take): thousands of phases released back to back on a
     team, the leader taking tasks from the front and the members from the back, every
     count a phase may have (none, one, a few, as many as a claim holds, one more, which
-    the leader runs alone), the ring of phase slots reused all the while; each task runs
-    exactly once. Repeated until the members have taken tasks, so that the claims were
-    contended."""
-    lib = native.library()
-    pattern = [0, 1, 2, 3, 5, 7, 16, 64, 2, 1, 2, 3]
-    tasks = np.array(pattern * 500 + [0xFFFF, 0x10000] + pattern * 500, dtype=np.int64)
-    for _ in range(20):
-        runs = np.zeros(int(tasks.sum()), dtype=np.int32)
-        with threads.team(jobs) as at:
-            by_members = lib.team_count(at, native.address(tasks), len(tasks), native.address(runs))
-        np.testing.assert_array_equal(runs, 1)
-        if by_members:
-            break
-    assert 0 < by_members < len(runs), "the pool's threads never took a task"
+    the leader runs alone), each phase with a context of its own while the ring of phase
+    slots is reused; each task runs exactly once. In a process of its own, so that a
+    hang (a task counted in the wrong phase's slot) shows as a timeout."""
+    subprocess.run([sys.executable, "-c", _CHECK_RUNS, str(jobs)], check=True, timeout=120, cwd=ROOT)

@@ -122,14 +122,14 @@ static void team_apart(const TeamCpus *c, int32_t leader_cpu, int32_t size)
  * the measured gain is net of that. */
 static void team_take(Team *t, int64_t p, TeamPhase *ph, int from_back)
 {
-    TeamTask fn = ph->fn;
-    void *ctx = ph->ctx;
     uint64_t v = atomic_load_explicit(&t->claim, memory_order_acquire);
     while ((uint32_t)(v >> 32) == (uint32_t)p && CLAIM_FRONT(v) < CLAIM_BACK(v)) {  /* phases past 2^32 too */
         uint64_t next = from_back ? v - 1 : v + (1u << 16);
         if (atomic_compare_exchange_weak_explicit(&t->claim, &v, next, memory_order_acq_rel,
                                                   memory_order_acquire)) {
-            fn(ctx, from_back ? CLAIM_BACK(v) - 1 : CLAIM_FRONT(v));
+            /* The slot is read only now: the swap acquired the leader's writes to it, and
+             * the leader rewrites it only after this task has finished. */
+            ph->fn(ph->ctx, from_back ? CLAIM_BACK(v) - 1 : CLAIM_FRONT(v));
             atomic_fetch_add_explicit(&ph->finished, 1, memory_order_release);
             v = atomic_load_explicit(&t->claim, memory_order_acquire);
         }
@@ -293,38 +293,35 @@ static _Thread_local char team_here;  /* its address tells the threads apart */
 typedef struct {
     TEAM_ATOMIC(int32_t) *runs;   /* one count per task of this phase */
     const char *leader;           /* the leader's team_here */
-    TEAM_ATOMIC(int64_t) *by_members;
-} TeamCount;
+} TeamCheck;
 
-static void team_count_task(void *ctx, int64_t k)
+/* Adds 1 to the task's count, and TEAM_BY_MEMBER more when a member runs it. */
+#define TEAM_BY_MEMBER 256
+
+static void team_check_task(void *ctx, int64_t k)
 {
-    TeamCount *c = ctx;
+    TeamCheck *c = ctx;
     for (volatile int32_t spin = 0; spin < 200; spin++)  /* a little work, so that members get some */
         ;
+    int32_t add = &team_here == c->leader ? 1 : 1 + TEAM_BY_MEMBER;
 #if TEAM_SOLO
-    c->runs[k]++;
-    *c->by_members += &team_here != c->leader;
+    c->runs[k] += add;
 #else
-    atomic_fetch_add_explicit(&c->runs[k], 1, memory_order_relaxed);
-    if (&team_here != c->leader)
-        atomic_fetch_add_explicit(c->by_members, 1, memory_order_relaxed);
+    atomic_fetch_add_explicit(&c->runs[k], add, memory_order_relaxed);
 #endif
 }
 
-/* Runs phases of tasks[0], tasks[1], ... tasks on team t, each task adding one to its
- * count in runs (the phases' counts one after another); returns how many tasks threads
- * other than the leader ran. */
-int64_t team_count(Team *t, const int64_t *tasks, int64_t phases, int32_t *runs)
+/* Runs phases of tasks[0], tasks[1], ... tasks on team t, each task adding to its count
+ * in runs (the phases' counts one after another) 1 when the leader runs it and 257 when a
+ * member does. Each phase has a context of its own (one of TEAM_RING + 1, in turn), so
+ * that a task run with another phase's slot counts in the wrong place. */
+void team_check_runs(Team *t, const int64_t *tasks, int64_t phases, int32_t *runs)
 {
-    TEAM_ATOMIC(int64_t) by_members = 0;
-    TeamCount c = {.leader = &team_here, .by_members = &by_members};
+    TeamCheck c[TEAM_RING + 1];
     for (int64_t p = 0, at = 0; p < phases; at += tasks[p++]) {
-        c.runs = (TEAM_ATOMIC(int32_t) *)(runs + at);
-        team_phase(t, team_count_task, &c, tasks[p]);
+        TeamCheck *mine = &c[p % (TEAM_RING + 1)];
+        mine->runs = (TEAM_ATOMIC(int32_t) *)(runs + at);
+        mine->leader = &team_here;
+        team_phase(t, team_check_task, mine, tasks[p]);
     }
-#if TEAM_SOLO
-    return by_members;
-#else
-    return atomic_load(&by_members);
-#endif
 }

@@ -273,7 +273,7 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
                          f"{statistics.median(times[2]):.4f} s: {ratio:.2f}x faster (quartiles of the rounds "
                          f"{low:.2f}-{high:.2f}x) {target}; two pinned "
                          f"processes in the same rounds render {statistics.median(ceilings):.2f}x the frames of one "
-                         f"(two_cpus.py), jobs=2 reaches {share:.0%} of that; {_placements(placed, ratios, unplaced)}")
+                         f"(two_cpus.py), jobs=2 reaches {share:.0%} of that; {_placements(placed, ratios, ceilings, unplaced)}")
             print(lines[-1], flush=True)
     return lines
 
@@ -289,22 +289,27 @@ def _placed(cpus: set[int], unplaced: str | None) -> placement.Placement | None:
         return None
 
 
-def _placements(placed: list[placement.Placement | None], ratios: list[float], unplaced: str | None) -> str:
+def _placements(placed: list[placement.Placement | None], ratios: list[float], ceilings: list[float],
+                unplaced: str | None) -> str:
     """Where the host had put the two CPUs in the rounds (placement.py): per placement, its
-    rounds, the median time of a line read across the CPUs and the rounds' median ratio;
-    then the rounds in which the CPUs moved (or a probe failed)."""
+    rounds, the median time of a line read across the CPUs, the rounds' median ratio and
+    their median ceiling (two_cpus.py); then the rounds in which the CPUs moved (or a probe
+    failed)."""
     if unplaced is not None:
         return f"the CPUs' placement not measured ({unplaced})"
+    rounds = list(zip(placed, ratios, ceilings))
     parts = []
     for kind in placement.KINDS:
-        mine = [(p, r) for p, r in zip(placed, ratios) if p is not None and p.kind == kind]
+        mine = [(p, r, c) for p, r, c in rounds if p is not None and p.kind == kind]
         if mine:
             parts.append(f"{len(mine)} rounds on {kind} (a line read across in "
-                         f"{statistics.median(p.cross_ns for p, _ in mine):.0f} ns): "
-                         f"{statistics.median(r for _, r in mine):.2f}x")
-    moved = [r for p, r in zip(placed, ratios) if p is None]
+                         f"{statistics.median(p.cross_ns for p, _, _ in mine):.0f} ns): "
+                         f"{statistics.median(r for _, r, _ in mine):.2f}x, two processes "
+                         f"{statistics.median(c for _, _, c in mine):.2f}x")
+    moved = [(r, c) for p, r, c in rounds if p is None]
     if moved:
-        parts.append(f"{len(moved)} rounds moved between placements: {statistics.median(moved):.2f}x")
+        parts.append(f"{len(moved)} rounds moved between placements: {statistics.median(r for r, _ in moved):.2f}x, "
+                     f"two processes {statistics.median(c for _, c in moved):.2f}x")
     return "the host placed the two CPUs (placement.py, probed before and after each round's frames): " + \
         ", ".join(parts)
 

@@ -67,11 +67,9 @@ static void shape_task(void *ctx, int64_t k)
     shape_range(b, edge(b->n, parts, k), edge(b->n, parts, k + 1));
 }
 
-/* Each shape's own cone or box, over a range of the tree's items (leaf order). */
-static void item_task(void *ctx, int64_t k)
+/* Each shape's own cone or box, over the tree's items a..e (leaf order). */
+static void item_range(const Bundle *b, int64_t a, int64_t e)
 {
-    const Bundle *b = ctx;
-    int64_t n = b->items, parts = shape_parts(n, b->jobs, b->chunk), a = edge(n, parts, k), e = edge(n, parts, k + 1);
     const int32_t *items = b->tree.items + a;
     if (b->kind == BVH_CONE)
         PICK(b, cone_items)(items, e - a, b->bnd, b->radius, b->tree.frame, b->own + CI_COLUMNS * a);
@@ -93,10 +91,21 @@ static void refit_range(const Bundle *b, int64_t lo, int64_t hi)
     bvh_refit(&b->tree, b->floor, b->kind, b->box, b->own, keys, b->node_keys, lo, hi);
 }
 
-static void refit_task(void *ctx, int64_t k)
+/* Subtree k's items, then its refit, so that the thread that makes a subtree's item
+ * bounds reads them. Nodes are depth first and leaves hold ranges of items in order: a
+ * subtree's items run from its leftmost leaf's first (left children: at + 1) to its
+ * rightmost leaf's last (right children: node[at][0]). */
+static void subtree_task(void *ctx, int64_t k)
 {
     const Subtrees *s = ctx;
-    refit_range(s->b, s->below[k][0], s->below[k][1]);
+    const int32_t *node = s->b->tree.node;
+    int64_t lo = s->below[k][0], left = lo, right = lo;
+    while (node[2 * left + 1] == 0)
+        left++;
+    while (node[2 * right + 1] == 0)
+        right = node[2 * right];
+    item_range(s->b, node[2 * left], (int64_t)node[2 * right] + node[2 * right + 1]);
+    refit_range(s->b, lo, s->below[k][1]);
 }
 
 /* At least want disjoint subtrees (fewer when the tree has fewer leaves; the largest
@@ -140,15 +149,17 @@ static void subtrees(const int32_t *node, int64_t nodes, int64_t want, Subtrees 
     }
 }
 
-/* The bundle's items and refit, after its radii are known. */
+/* The bundle's items and refit, after its radii are known: subtrees side by side, each
+ * with its items (a pass of its own over the items, in even ranges, lost 25 us a frame at
+ * 4,096 spheres when the two threads' cores had separate L3s: each thread then read item
+ * bounds the other had made; docs/performance.md), then the nodes above them. */
 static void bundle_tree(Bundle *b, Team *team)
 {
     int64_t parts = shape_parts(b->items, b->jobs, b->chunk);
-    team_phase(team, item_task, b, parts);
     Subtrees s = {.b = b};
     int64_t above[MAX_PARTS], n_above;
     subtrees(b->tree.node, b->tree.nodes, parts, &s, above, &n_above);
-    team_phase(team, refit_task, &s, s.count);
+    team_phase(team, subtree_task, &s, s.count);
     for (int64_t i = n_above - 1; i >= 0; i--)  /* parents after their children */
         refit_range(b, above[i], above[i] + 1);
 }

@@ -167,7 +167,6 @@ void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
     TeamPhase *ph = &t->ring[p % TEAM_RING];
     ph->fn = fn;
     ph->ctx = ctx;
-    ph->tasks = tasks;
     atomic_store_explicit(&ph->finished, 0, memory_order_relaxed);
     atomic_store_explicit(&t->leader_cpu, team_cpu(), memory_order_relaxed);
     atomic_store_explicit(&t->claim, (uint64_t)p << 32 | (uint64_t)tasks, memory_order_release);

@@ -47,7 +47,6 @@ typedef void (*TeamTask)(void *ctx, int64_t k);
 typedef struct {
     TeamTask fn;
     void *ctx;
-    int64_t tasks;
     TEAM_ATOMIC(int64_t) finished;
 } TeamPhase;
 

@@ -18,6 +18,7 @@
 
 typedef struct {
     int64_t *chain;              /* LINES lines, each holding the index of the next */
+    int32_t order[LINES];        /* the lines' order in the chain (shuffle) */
     int32_t cpu[2];              /* the writer's, the reader's */
     int32_t rounds;
     _Atomic int32_t turn;        /* 2r + 1: round r written; 2r + 2: read */
@@ -60,11 +61,9 @@ static inline void relax(void)
 #endif
 }
 
-/* Writes the chain: a cycle through every line in a fixed shuffled order, so that no
- * prefetcher guesses the next line. */
-static void write_chain(int64_t *chain)
+/* A fixed shuffled order of the lines, so that no prefetcher guesses the next one. */
+static void shuffle(int32_t *order)
 {
-    int32_t order[LINES];
     uint64_t seed = 0x9E3779B97F4A7C15u;
     for (int32_t i = 0; i < LINES; i++)
         order[i] = i;
@@ -74,23 +73,45 @@ static void write_chain(int64_t *chain)
         order[i] = order[j];
         order[j] = t;
     }
+}
+
+/* Writes the chain: a cycle through every line in p's order. */
+static void write_chain(Probe *p)
+{
     for (int32_t i = 0; i < LINES; i++)
-        chain[(int64_t)order[i] * STRIDE] = (int64_t)order[(i + 1) % LINES] * STRIDE;
+        p->chain[(int64_t)p->order[i] * STRIDE] = (int64_t)p->order[(i + 1) % LINES] * STRIDE;
+}
+
+/* Pins the calling thread to p's CPU `which` (0: the writer's, 1: the reader's); a
+ * failure ends both threads. */
+static void pin_or_fail(Probe *p, int which)
+{
+    if (pin(p->cpu[which]) != 0)
+        atomic_store(&p->failed, 1);
+}
+
+/* Waits until p's turn is `turn`; 0 when the other thread failed instead. */
+static int await_turn(Probe *p, int32_t turn)
+{
+    while (atomic_load(&p->turn) != turn)
+        if (atomic_load(&p->failed))
+            return 0;
+        else
+            relax();
+    return 1;
 }
 
 static void *writer(void *arg)
 {
     Probe *p = arg;
     volatile int64_t sink;
-    if (pin(p->cpu[0]) != 0)
-        atomic_store(&p->failed, 1);
+    pin_or_fail(p, 0);
     for (int32_t r = 0; r < p->rounds && !atomic_load(&p->failed); r++) {
-        write_chain(p->chain);
+        write_chain(p);
         p->own[r] = follow(p->chain, &sink);
-        write_chain(p->chain);  /* the lines modified in this CPU's cache again */
+        write_chain(p);  /* the lines modified in this CPU's cache again */
         atomic_store(&p->turn, 2 * r + 1);
-        while (atomic_load(&p->turn) != 2 * r + 2 && !atomic_load(&p->failed))
-            relax();
+        await_turn(p, 2 * r + 2);
     }
     return NULL;
 }
@@ -99,11 +120,8 @@ static void *reader(void *arg)
 {
     Probe *p = arg;
     volatile int64_t sink;
-    if (pin(p->cpu[1]) != 0)
-        atomic_store(&p->failed, 1);
-    for (int32_t r = 0; r < p->rounds && !atomic_load(&p->failed); r++) {
-        while (atomic_load(&p->turn) != 2 * r + 1 && !atomic_load(&p->failed))
-            relax();
+    pin_or_fail(p, 1);
+    for (int32_t r = 0; r < p->rounds && await_turn(p, 2 * r + 1); r++) {
         p->cross[r] = follow(p->chain, &sink);
         atomic_store(&p->turn, 2 * r + 2);
     }
@@ -133,6 +151,7 @@ int32_t cross_read_ns(int32_t from, int32_t to, int32_t rounds, double *out)
         p->cpu[0] = from;
         p->cpu[1] = to;
         p->rounds = rounds;
+        shuffle(p->order);
         pthread_t w, r;
         if (pthread_create(&w, NULL, writer, p) == 0) {
             if (pthread_create(&r, NULL, reader, p) == 0)

@@ -30,6 +30,7 @@ import ctypes
 import os
 import shutil
 import subprocess
+import sys
 import sysconfig
 import tempfile
 import time
@@ -123,12 +124,19 @@ def main() -> int:
     if why:
         print(f"not measured: {why}")
         return 0
-    for k in range(args.measures):
-        p = measure(os.sched_getaffinity(0))
-        print(f"{p.kind:>12}: a line written on the other CPU read in {p.cross_ns:5.1f} ns, "
-              f"one of its own in {p.own_ns:4.1f} ns", flush=True)
-        if k + 1 < args.measures:
-            time.sleep(1)
+    try:
+        for k in range(args.measures):
+            p = measure(os.sched_getaffinity(0))
+            print(f"{p.kind:>12}: a line written on the other CPU read in {p.cross_ns:5.1f} ns, "
+                  f"one of its own in {p.own_ns:4.1f} ns", flush=True)
+            if k + 1 < args.measures:
+                time.sleep(1)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+    except RuntimeError as e:  # a CPU taken away meanwhile
+        print(e, file=sys.stderr)
+        return 1
     return 0
 
 

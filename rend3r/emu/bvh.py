@@ -131,5 +131,5 @@ def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
     items, always, node = np.empty(n, np.int32), np.empty(n, np.int32), np.empty((max(1, 2 * n), 2), np.int32)
     counts, room = np.zeros(2, np.int64), empty(n * native.BUILD_BYTES // 8, np.uint64)
     nodes = native.library().bvh_build(address(bnd), address(ok), n, address(items), address(always), address(node),
-                                       address(counts), address(room))
+                                       address(counts), address(room), 0)  # new arrays: every entry written
     return Tree(node[:nodes], items[:counts[0]], always[:counts[1]])

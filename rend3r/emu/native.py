@@ -195,14 +195,14 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
     "directions": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "nearest": (None, [POINTER(Band), c_int64, c_int64, c_void_p]),
     "shape_tables": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_double, c_void_p, c_void_p,
-                               c_void_p, c_void_p, c_void_p, POINTER(Format)]),
+                               c_void_p, c_void_p, c_void_p, POINTER(Format), c_int32]),
     "light_pass": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
     "shadow_origins": (None, [POINTER(LightPass), c_int64, c_int64, c_void_p]),
     "trace_pixel": (c_int64, [POINTER(Band), c_int32, c_int32, c_void_p, c_void_p, c_int64, c_int64, c_int64,
                               c_void_p, c_void_p, c_void_p]),
 }
 _PLAIN = {
-    "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p]),
+    "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_int32]),
     "have_avx2": (c_int32, []),
     "have_avx512": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),

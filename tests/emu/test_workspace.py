@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import sys
 import threading
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from rend3r.emu import workspace
+from rend3r.isa import FrameOp, Func, ShapeSet, Table, encode, lookup
+from rend3r.isa.float16 import float_to_bits
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.run import run_program
 
@@ -188,3 +191,35 @@ def test_repeated_frames_keep_their_memory_and_their_pixels(precision: str, monk
 
     _on_a_thread_of_its_own(runs)
     assert 0 < kept[0] and kept[-1] == kept[-2] == kept[-3] <= 2 * kept[0], kept
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_frames_whose_shapes_move_overwrite_the_rows_they_change(jobs: int, monkeypatch) -> None:
+    """Frames of one run in the same buffers, the shapes moving between them (every other
+    sphere, then a quarter of them back, then none): on a team of threads the bound table
+    and the tree are written only where they differ (csrc/datapath.inc shape_tables,
+    csrc/kernels.c bvh_build), so each frame's set-up finds the last frame's rows in
+    place. Every frame and its counts of tests equal those rendered with fresh arrays (a
+    stale bound would cull a moved sphere, or test every one)."""
+    wall = walls.wall(4096, lights=1)
+    words = list(wall.words[:-2])  # without nf, er
+    xloc, yloc = (lookup(Table.SHAPE, name).index for name in ("xloc", "yloc"))
+    nf, er = list(encode(FrameOp(Func.NF))), list(encode(FrameOp(Func.ER)))
+    for moved, step in ((range(0, 4096, 2), 0.25), (range(0, 4096, 4), -0.25), (range(0), 0.0)):
+        words += nf
+        for s in moved:
+            x, y = wall.centers[s, :2] + step
+            words += encode(ShapeSet(s, xloc, yloc, float_to_bits(x), float_to_bits(y)))
+    words = np.array(words + nf + er, np.uint32)
+    options = EmuOptions(precision="fp32", width=96, height=64, jobs=jobs)
+    with monkeypatch.context() as m:  # one thread (every row written) into fresh arrays
+        m.setattr(workspace, "SMALLEST", 1 << 62)  # no array takes a buffer
+        fresh = run_program(words, replace(options, jobs=1), memory=0)
+    got: list = []  # memory=0: the frames one after another, each on the whole team
+    _on_a_thread_of_its_own(lambda: got.append(run_program(words, options, memory=0)))
+    assert len(got[0].frames) == len(fresh.frames) == 4
+    for a, b, sa, sb in zip(got[0].frames, fresh.frames, got[0].stats.frames, fresh.stats.frames):
+        assert a.rgb565.tobytes() == b.rgb565.tobytes() and a.depth.tobytes() == b.depth.tobytes()
+        assert a.provenance.tobytes() == b.provenance.tobytes()
+        assert (sa.tests, sa.skipped, sa.shadow_rays) == (sb.tests, sb.skipped, sb.shadow_rays)
+    assert got[0].frames[1].rgb565.tobytes() != got[0].frames[0].rgb565.tobytes()  # the shapes did move

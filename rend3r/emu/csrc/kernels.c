@@ -145,6 +145,13 @@ static uint64_t *radix_sort(uint64_t *key, uint64_t *tmp, int64_t n)
     return key;
 }
 
+/* *at = v; with keep, written only where it differs. */
+static inline void put(int32_t *at, int32_t v, int32_t keep)
+{
+    if (!keep || *at != v)
+        *at = v;
+}
+
 /* The hierarchy over the shapes of bnd (n rows) that are bounded with a finite centre;
  * their slots go to items (count[0] of them), the others' to always (count[1]). The
  * shapes are ordered along a Morton curve of their centres, quantised to 2**MORTON_BITS
@@ -155,9 +162,12 @@ static uint64_t *radix_sort(uint64_t *key, uint64_t *tmp, int64_t n)
  * rounded up to whole leaves.
  * Leaves hold at most BVH_LEAF shapes. items is ordered leaf by leaf; node (2 ints per
  * node, room for 2n nodes) gets the nodes depth first; room (rows x BUILD_BYTES, 8-byte
- * aligned) holds the working copies. Returns the node count. */
+ * aligned) holds the working copies. With keep (other threads read the tree), items,
+ * always and node are written only where they differ: the tree depends on the centres
+ * alone, and a frame whose shapes did not move then leaves the last frame's in the other
+ * threads' caches (docs/performance.md, "Rows left alone"). Returns the node count. */
 int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
-                  int32_t *node, int64_t *count_out, void *room)
+                  int32_t *node, int64_t *count_out, void *room, int32_t keep)
 {
     int64_t stack[4 * BVH_STACK], top = 1, count = 0, n = 0, outside = 0;
     count_out[0] = count_out[1] = 0;
@@ -169,7 +179,7 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     for (int64_t s = 0; s < rows; s++) {
         const double *c = bnd + B_COLUMNS * s;
         if (!(bounded[s] && isfinite(c[0]) && isfinite(c[1]) && isfinite(c[2]))) {
-            always[outside++] = (int32_t)s;
+            put(always + outside++, (int32_t)s, keep);
             continue;
         }
         BuildItem *t = a + n++;
@@ -205,10 +215,10 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
         int64_t lo = stack[4 * top], hi = stack[4 * top + 1], parent = stack[4 * top + 2], depth = stack[4 * top + 3];
         int64_t at = count++;
         if (parent >= 0)
-            node[2 * parent] = (int32_t)at;
+            put(node + 2 * parent, (int32_t)at, keep);
         if (hi - lo <= BVH_LEAF || depth + 2 >= BVH_STACK) {  /* traversal stacks hold depth + 2 nodes */
-            node[2 * at] = (int32_t)lo;
-            node[2 * at + 1] = (int32_t)(hi - lo);
+            put(node + 2 * at, (int32_t)lo, keep);
+            put(node + 2 * at + 1, (int32_t)(hi - lo), keep);
             continue;
         }
         int64_t mid;
@@ -234,13 +244,13 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
             if (bh[axis] > bl[axis])  /* else every centre is the same */
                 select_nth(a, lo, hi, mid, axis);
         }
-        node[2 * at + 1] = 0;
+        put(node + 2 * at + 1, 0, keep);
         int64_t right[4] = {mid, hi, at, depth + 1}, left[4] = {lo, mid, -1, depth + 1};
         memcpy(stack + 4 * top++, right, sizeof right);  /* after the left subtree */
         memcpy(stack + 4 * top++, left, sizeof left);    /* the next node */
     }
     for (int64_t i = 0; i < n; i++)
-        items[i] = a[i].slot;
+        put(items + i, a[i].slot, keep);
     return count;
 }
 

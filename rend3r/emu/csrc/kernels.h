@@ -163,7 +163,8 @@ enum { PROP_WORDS = 32 };
 /* A precision's shape_tables (datapath.inc). */
 typedef int64_t (*ShapeTablesFn)(const uint16_t *values, const int64_t *index, int64_t rows, const int32_t *props,
                                  const int32_t *kinds, const void *cam, double tiny, void *sf, int64_t *si,
-                                 double *bnd, uint8_t *bounded, int32_t *index_out, const Format *format);
+                                 double *bnd, uint8_t *bounded, int32_t *index_out, const Format *format,
+                                 int32_t keep);
 
 typedef struct {            /* a frame's set-up (setup.c frame_setup) */
     ShapeTablesFn tables;

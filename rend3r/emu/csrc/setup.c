@@ -43,7 +43,7 @@ SHAPE_PASSES(avx512)
 #endif
 
 int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
-                  int32_t *node, int64_t *count_out, void *room);
+                  int32_t *node, int64_t *count_out, void *room, int32_t keep);
 void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items, const double *keys,
                double *node_keys, int64_t lo, int64_t hi);
 
@@ -189,7 +189,7 @@ static void tables_task(void *ctx, int64_t k)
     int64_t a = edge(s->rows, t->parts, k), e = edge(s->rows, t->parts, k + 1);
     t->on[k] = s->tables(s->values + PROP_WORDS * a, s->index + a, e - a, s->props, s->kinds, s->cam, s->tiny,
                          s->sf + s->sf_row * a, s->si + SI_COLUMNS * a, s->bnd + B_COLUMNS * a, s->bounded + a,
-                         s->index_out + a, s->format);
+                         s->index_out + a, s->format, s->jobs > 1);
 }
 
 /* Task 0 builds the tree, the others run the primary bundle's shape pass. */
@@ -198,7 +198,8 @@ static void build_task(void *ctx, int64_t k)
     Tables *t = ctx;
     Setup *s = t->s;
     if (k == 0)
-        s->nodes = bvh_build(s->bnd, s->bounded, s->shapes, s->items, s->always, s->node, s->counts, s->room);
+        s->nodes = bvh_build(s->bnd, s->bounded, s->shapes, s->items, s->always, s->node, s->counts, s->room,
+                             s->jobs > 1);
     else
         shape_task(t->primary, k - 1);
 }

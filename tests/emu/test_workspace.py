@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from rend3r.emu import workspace
-from rend3r.isa import FrameOp, Func, ShapeSet, Table, encode, lookup
-from rend3r.isa.float16 import float_to_bits
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.run import run_program
+from rend3r.isa import FrameOp, Func, ShapeSet, Table, encode, lookup
+from rend3r.isa.float16 import float_to_bits
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 import walls  # noqa: E402

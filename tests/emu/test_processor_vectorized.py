@@ -418,3 +418,52 @@ def test_pairs_back_to_back_decode_alike_on_both_instruction_sets(instruction_se
         native.choose(None)
         processor.PAIR_CHUNK = chunk
     assert got == _outcome(reference, words, options, None)
+
+
+#: Shapes in index order, as programs set them up: each index a step (0: the same index
+#: again, in a run of its own) above the one before, with its pairs (some store nothing).
+_ORDERED_SHAPES = st.lists(st.tuples(st.integers(0, 2), st.lists(st.tuples(_PROP, _PROP, _SD), min_size=1, max_size=9),
+                                     st.booleans()), min_size=1, max_size=40)
+
+
+def _ordered_words(first: int, shapes: list, gap: list[int], back: tuple[int, int] | None) -> list[int]:
+    """The shapes' pairs from index first on, the index going back by back[1] at shape
+    back[0] (None: never)."""
+    words, index = [], first
+    for k, (step, pairs, broken) in enumerate(shapes):
+        index = max(0, index - back[1]) if back is not None and k == back[0] % len(shapes) else index + step
+        words += [w for p, q, sd in pairs for w in (encode(ShapeSet(index, p, q, 0, 0))[0], sd)]
+        words += gap if broken else []
+    return words
+
+
+@pytest.mark.parametrize("instruction_set", ["base", "avx2"])
+@settings(max_examples=300)
+@given(st.integers(0, 1000), _ORDERED_SHAPES, _ORDERED_SHAPES, st.sampled_from([[], list(encode(CameraSet(1, 7)))]),
+       st.none() | st.tuples(st.integers(0, 40), st.integers(1, 2)), st.integers(2, 4))
+def test_pairs_in_index_order_are_written_by_each_range_in_order(instruction_set, first, shapes, again, gap, back,
+                                                                 jobs):
+    """Pairs that write their indices in order are written range by range on several
+    threads (csrc/kernels.c pair_apply_team), the writes to an index that ranges share
+    (a shape whose pairs a range edge splits, or a range of one shape's pairs only) made in
+    program order: the scenes of the reference interpreter, for a new table (pairs_grow) and
+    for a second frame that writes, in order, to rows the table has (in place), with each
+    range's indices found a pair at a time and eight at a time (marks8). An index that goes
+    back by one or two (an earlier range may have written it) must leave the ranges to one
+    thread, in order."""
+    from rend3r.emu import native
+
+    if not native.runs(instruction_set):
+        pytest.skip("this processor has no AVX2")
+    import rend3r.emu.processor as processor
+
+    words = [NR, *_ordered_words(first, shapes, gap, back), NF, *_ordered_words(first, again, gap, back), NF]
+    options = EmuOptions(jobs=jobs)
+    chunk, processor.PAIR_CHUNK = processor.PAIR_CHUNK, 2  # a few pairs a range: edges inside shapes
+    native.choose(instruction_set)
+    try:
+        got = _outcome(vectorized, words, options, None)
+    finally:
+        native.choose(None)
+        processor.PAIR_CHUNK = chunk
+    assert got == _outcome(reference, words, options, None)

@@ -210,9 +210,9 @@ _PLAIN = {
                            c_void_p]),
     "word_writes": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p]),
     "pairs_rows": (c_int64, [c_void_p, POINTER(Pairs), c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p,
-                             c_void_p, c_int64, c_void_p]),
-    "pairs_grow": (None, [c_void_p, POINTER(Pairs), c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_int64,
-                          c_void_p, c_int64, c_void_p, c_void_p, c_void_p]),
+                             c_int64, c_void_p]),
+    "pairs_grow": (None, [c_void_p, POINTER(Pairs), c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_int64, c_void_p,
+                          c_int64, c_void_p, c_void_p, c_void_p]),
     "team_open": (c_void_p, [c_int32]),
     "team_close": (None, [c_void_p]),
     "team_check_runs": (None, [c_void_p, c_void_p, c_int64, c_void_p]),  # tests only (team.c)

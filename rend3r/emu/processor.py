@@ -264,7 +264,7 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
     (csrc/kernels.c pairs_rows, pairs_grow): over their words, the indices written and
     each pair decoded (in ranges of pairs on a team of ``jobs`` threads when there are
     many), the table's rows for them, then over the decoded pairs the writes: each range
-    of pairs on the thread that decoded it when the ranges write their indices in order,
+    of pairs on the thread that decoded it while the ranges write their indices in order,
     else all in order on one thread (threads that each took a range of rows spent nearly as
     long reading every pair as one thread writing them all). A new index gets a new table,
     its rows in index order, of the size it needs: the second call comes only then."""
@@ -276,19 +276,18 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
                          None if tables is None else address(tables), entry, address(wanted), address(_SE_NULL),
                          address(records), native.avx2())
     count = threads.parts(len(at), jobs, PAIR_CHUNK)
-    tops, lows = np.empty(count, np.int64), np.empty(count, np.int64)
+    tops = np.empty(count, np.int64)
     if had and not table.values.flags.writeable:  # the writes may go in place: into a copy of a read-only table
         table.values = table.values.copy()
     lib, old = native.library(), (native.ptr(index, np.int64, (had,)), had,
                                   native.ptr(table.values, np.uint16, (had, PROP_LIMIT)))
     with threads.team(jobs if count > 1 else 1) as team:
-        rows = lib.pairs_rows(team, byref(pairs), count, address(scratch.mark), address(tops), address(lows),
+        rows = lib.pairs_rows(team, byref(pairs), count, address(scratch.mark), address(tops),
                               address(scratch.row_of), address(scratch.merged), *old)
         if rows > had:
             new_index, values = empty(rows, np.int64), empty((rows, PROP_LIMIT), np.uint16)
-            lib.pairs_grow(team, byref(pairs), count, address(tops), address(lows), address(scratch.mark),
-                           address(scratch.row_of), address(scratch.merged), rows, *old, address(new_index),
-                           address(values))
+            lib.pairs_grow(team, byref(pairs), count, address(tops), address(scratch.mark), address(scratch.row_of),
+                           address(scratch.merged), rows, *old, address(new_index), address(values))
             table.index, table.values = new_index, values
     if rows < 0:
         scratch.mark[:] = 0

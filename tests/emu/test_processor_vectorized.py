@@ -449,8 +449,8 @@ def test_pairs_in_index_order_are_written_by_each_range_in_order(instruction_set
     program order: the scenes of the reference interpreter, for a new table (pairs_grow) and
     for a second frame that writes, in order, to rows the table has (in place), with each
     range's indices found a pair at a time and eight at a time (marks8). An index that goes
-    back by one or two (an earlier range may have written it) must leave the ranges to one
-    thread, in order."""
+    back by one or two (an earlier range may have written it) stops the ranges, and one
+    thread writes every pair again, in order, over what they wrote."""
     from rend3r.emu import native
 
     if not native.runs(instruction_set):

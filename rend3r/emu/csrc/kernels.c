@@ -656,12 +656,11 @@ static inline unsigned pair_stores(const uint8_t *wanted, const uint8_t *null, c
     return wanted[*table] ? (unsigned)!nulls[FIELD(*f, se, 2)] | (unsigned)!nulls[FIELD(*f, se, 3)] << 1 : 0u;
 }
 
-/* What marks carries from pair to pair: the largest index marked + 1, the smallest marked,
- * and the previous pair's index and whether it stored a word (a pair that stores to the
- * index the previous pair stored to need not mark it again: pairs of a shape mostly come
- * together). */
+/* What marks carries from pair to pair: the largest index marked + 1, and the previous
+ * pair's index and whether it stored a word (a pair that stores to the index the previous
+ * pair stored to need not mark it again: pairs of a shape mostly come together). */
 typedef struct {
-    int64_t top, low, index;
+    int64_t top, index;
     unsigned stores;
 } MarkState;
 
@@ -686,7 +685,6 @@ static inline __attribute__((always_inline)) int64_t mark_one(const Pairs *p, co
     if (stores && !(m->stores && m->index == index)) {
         __atomic_store_n(mark + index, 1, __ATOMIC_RELAXED);  /* ranges of pairs on several threads */
         m->top = index >= m->top ? index + 1 : m->top;
-        m->low = index < m->low ? index : m->low;
     }
     m->index = index;
     m->stores = stores;
@@ -705,8 +703,7 @@ static inline __attribute__((always_inline)) int64_t mark_one(const Pairs *p, co
 static int64_t marks8(const uint32_t *words, const int64_t *at, int64_t n, int64_t n_words, uint64_t *records,
                       const PairFields *f, uint32_t null_bits, int take, uint8_t *mark, int64_t k, MarkState *m)
 {
-    u32x8 top = {0}, lowest = (u32x8){0} + UINT32_MAX;
-    u32x8 prev_index = (u32x8){0} + (uint32_t)m->index, prev_stores = (u32x8){0} + m->stores;
+    u32x8 top = {0}, prev_index = (u32x8){0} + (uint32_t)m->index, prev_stores = (u32x8){0} + m->stores;
     int64_t start = k;
     for (; k + 8 <= n; k += 8) {
         i64x4 a0, a1, first = (i64x4){0, 2, 4, 6} + at[k];
@@ -735,18 +732,15 @@ static int64_t marks8(const uint32_t *words, const int64_t *at, int64_t n, int64
         int marks = mask_bits_32x8(storing & ~((i32x8)(stored != 0) & (i32x8)(before == index)));
         for (; marks; marks &= marks - 1)
             __atomic_store_n(mark + index[__builtin_ctz(marks)], 1, __ATOMIC_RELAXED);
-        u32x8 next = (index + 1) & (u32x8)storing, least = index | ~(u32x8)storing;
+        u32x8 next = (index + 1) & (u32x8)storing;
         top = (u32x8)((i32x8)(next > top) & (i32x8)next) | (u32x8)(~(i32x8)(next > top) & (i32x8)top);
-        lowest = (u32x8)((i32x8)(least < lowest) & (i32x8)least) | (u32x8)(~(i32x8)(least < lowest) & (i32x8)lowest);
         prev_index = index;
         prev_stores = stores;
     }
     if (k == start)
         return k;
-    for (int i = 0; i < 8; i++) {
+    for (int i = 0; i < 8; i++)
         m->top = top[i] > m->top ? top[i] : m->top;
-        m->low = lowest[i] < m->low ? lowest[i] : m->low;
-    }
     m->index = prev_index[7];
     m->stores = prev_stores[7];
     return k;
@@ -758,13 +752,12 @@ static int64_t marks8(const uint32_t *words, const int64_t *at, int64_t n, int64
 
 /* Marks the index of every pair taken that stores a word: mark[index] = 1 (mark holds
  * 2^19 bytes, every index; threads may mark ranges of pairs at once), and decodes every
- * pair into its record (pair_record). Returns the largest index marked + 1 (0 for none),
- * the smallest into *low, or -1 - k for the first pair k whose SD lies outside the words
- * (then nothing may be written). With AVX2 and one table, blocks of eight pairs back to
- * back are decoded at once (marks8): a 65,536-sphere program's 327,680 pairs took 1.29 ms
- * one at a time. */
-static inline __attribute__((always_inline)) int64_t marks(const Pairs *p, uint8_t *mark, int one_table,
-                                                           int64_t *low)
+ * pair into its record (pair_record). Returns the largest
+ * index marked + 1 (0 for none), or -1 - k for the first pair k whose SD lies outside the
+ * words (then nothing may be written). With AVX2 and one table, blocks of eight pairs
+ * back to back are decoded at once (marks8): a 65,536-sphere program's 327,680 pairs took
+ * 1.29 ms one at a time. */
+static inline __attribute__((always_inline)) int64_t marks(const Pairs *p, uint8_t *mark, int one_table)
 {
     const uint32_t *words = p->words;
     const int64_t *at = p->at;
@@ -776,7 +769,7 @@ static inline __attribute__((always_inline)) int64_t marks(const Pairs *p, uint8
     uint32_t null_bits = 0;
     for (int i = 0; one_table && i < 32; i++)
         null_bits |= (uint32_t)(p->null[32 * (p->entry - 1) + i] != 0) << i;
-    MarkState m = {0, INT64_MAX, -1, 0};
+    MarkState m = {0, -1, 0};
     for (int64_t k = 0; k < n;) {
 #if MARKS8
         if (eight && k + 8 <= n && at[k + 7] == at[k] + 14)  /* else scattered pairs would try each block */
@@ -787,13 +780,12 @@ static inline __attribute__((always_inline)) int64_t marks(const Pairs *p, uint8
                 return -1 - k;
     }
     (void)eight;
-    *low = m.low;
     return m.top;
 }
 
-static int64_t pair_marks(const Pairs *p, uint8_t *mark, int64_t *low)
+static int64_t pair_marks(const Pairs *p, uint8_t *mark)
 {
-    return p->tables == NULL ? marks(p, mark, 1, low) : marks(p, mark, 0, low);  /* NULL: no TS word, one table */
+    return p->tables == NULL ? marks(p, mark, 1) : marks(p, mark, 0);  /* NULL: no TS word, one table */
 }
 
 /* Range k of the pairs p split into parts (team.h edge). */
@@ -812,26 +804,26 @@ typedef struct {
     const Pairs *p;
     int64_t parts;
     uint8_t *mark;
-    int64_t *tops, *lows;
+    int64_t *tops;
 } PairRanges;
 
 static void pair_range(void *ctx, int64_t k)
 {
     const PairRanges *r = ctx;
     Pairs part = pair_part(r->p, r->parts, k);
-    r->tops[k] = pair_marks(&part, r->mark, r->lows + k);
+    r->tops[k] = pair_marks(&part, r->mark);
 }
 
 /* pair_marks over `parts` ranges of the pairs on a team (team.h), range k's result into
- * tops[k], its smallest index marked into lows[k]. */
-static void pair_marks_team(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, int64_t *tops, int64_t *lows)
+ * tops[k]. */
+static void pair_marks_team(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, int64_t *tops)
 {
-    PairRanges r = {p, parts < 1 ? 1 : parts, mark, tops, lows};
+    PairRanges r = {p, parts < 1 ? 1 : parts, mark, tops};
     team_phase(team, pair_range, &r, r.parts);
 }
 
-/* The writes a range of pairs makes to an index an earlier range wrote too (index; -1:
- * none), kept aside to be made after that range's: the words and which were written. */
+/* A range of pairs' writes to the largest index the ranges before it wrote (index; -1:
+ * none), kept aside to be made after theirs: the words, and which were written. */
 typedef struct {
     int64_t index;
     uint32_t written;
@@ -839,16 +831,19 @@ typedef struct {
 } PairShadow;
 
 /* Writes the pairs taken, in order, to a table of 32 property words per row (the last
- * write to a word wins), row row_of[index], from the records pair_marks decoded; the
- * writes to shadow->index (NULL: none) go to the shadow instead. The row of the last index
- * is kept: a shape's pairs mostly come together, and a store whose address waits on a
- * row_of load each time ran at half the speed. A row whose index is fresh (fresh[index] !=
- * 0; NULL: none) is zeroed as it is first written, and its flag cleared: a pass of its own
- * over a new table's rows took a tenth of the processor's time at 65,536 spheres. */
-static void pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values, uint8_t *fresh, PairShadow *shadow)
+ * write to a word wins), row row_of[index], from the records pair_marks decoded. The row
+ * of the last index is kept: a shape's pairs mostly come together, and a store whose
+ * address waits on a row_of load each time ran at half the speed. A row whose index is
+ * fresh (fresh[index] != 0; NULL: none) is zeroed as it is first written, and its flag
+ * cleared: a pass of its own over a new table's rows took a tenth of the processor's time
+ * at 65,536 spheres. With a shadow (NULL: none), the writes to shadow->index go to it
+ * instead, and a pair whose index is below that one stops the writes: returns 0 then, 1
+ * when every pair was written. */
+static inline __attribute__((always_inline)) int pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values,
+                                                            uint8_t *fresh, PairShadow *shadow)
 {
     const uint64_t *records = p->records;
-    int64_t n = p->n, last = -1, aside = shadow != NULL ? shadow->index : -1;
+    int64_t n = p->n, last = -1, floor = shadow != NULL ? shadow->index : -1;
     uint16_t *row = values;
     uint32_t written = 0;
     for (int64_t k = 0; k < n; k++) {
@@ -858,7 +853,9 @@ static void pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values, 
         int64_t index = (int64_t)(r >> 12 & 0xFFFFFu);
         if (index != last) {
             last = index;
-            if (index == aside) {
+            if (index <= floor) {
+                if (index < floor)
+                    return 0;
                 row = shadow->row;
             } else {
                 row = values + 32 * (int64_t)row_of[index];
@@ -868,7 +865,7 @@ static void pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values, 
                 }
             }
         }
-        if (index == aside)
+        if (shadow != NULL && index == floor)
             written |= (r & 1u ? 1u << (r >> 7 & 31u) : 0u) | (r & 2u ? 1u << (r >> 2 & 31u) : 0u);
         if (r & 1u)
             row[r >> 7 & 31u] = (uint16_t)(r >> 48);
@@ -877,6 +874,7 @@ static void pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values, 
     }
     if (shadow != NULL)
         shadow->written = written;
+    return 1;
 }
 #undef FIELD
 
@@ -886,6 +884,7 @@ typedef struct {
     const int32_t *row_of;
     uint16_t *values;
     uint8_t *fresh;
+    int32_t disorder;  /* a range found an index below its shadow's */
     PairShadow shadow[MAX_PARTS];
 } PairWrites;
 
@@ -893,48 +892,57 @@ static void pair_apply_range(void *ctx, int64_t k)
 {
     PairWrites *w = ctx;
     Pairs part = pair_part(w->p, w->parts, k);
-    pair_apply(&part, w->row_of, w->values, w->fresh, &w->shadow[k]);
+    if (!__atomic_load_n(&w->disorder, __ATOMIC_RELAXED)
+        && !pair_apply(&part, w->row_of, w->values, w->fresh, &w->shadow[k]))
+        __atomic_store_n(&w->disorder, 1, __ATOMIC_RELAXED);
 }
 
-/* pair_apply over the pairs p that pair_marks_team decoded in `parts` ranges (tops[k],
- * lows[k]: range k's largest index marked + 1 and its smallest). When each range writes
- * no index below the largest an earlier range wrote (pairs in index order, as a program
- * that sets its shapes up one after another has them), the ranges write on the team, each
- * range on the thread that most likely decoded it (team.h: the same end of the ranges),
- * so its records and rows stay in that thread's cache: the leader writing them all took
- * 145 us at 4,096 spheres when the two threads' cores had separate L3s, 33 on a shared L3
- * (docs/performance.md). A range's writes to that largest index wait in its shadow and
- * are made after the earlier ranges', in order. Otherwise one thread writes them all, in
- * order. */
-static void pair_apply_team(Team *team, const Pairs *p, int64_t parts, const int64_t *tops, const int64_t *lows,
-                            const int32_t *row_of, uint16_t *values, uint8_t *fresh)
+/* pair_apply over the pairs p that pair_marks_team decoded in `parts` ranges (tops[k]:
+ * range k's largest index marked + 1). Programs set their shapes up one after another, so
+ * each range's indices mostly lie at or above the largest the ranges before it wrote:
+ * then the ranges write on the team, each on the thread that most likely decoded it
+ * (team.h: each thread keeps its end of the ranges), so its records and rows stay in that
+ * thread's cache. The leader writing them all took 145 us at 4,096 spheres when the two
+ * threads' cores had separate L3s, 33 on a shared L3 (docs/performance.md). A range's
+ * writes to that largest index wait in its shadow and are made after the phase, range by
+ * range, so the last write to a word still wins. A range that meets a lower index stops,
+ * and one thread then writes every pair again, in order, over what the ranges wrote: the
+ * last write to each word is the same, and a fresh row was zeroed before its first write.
+ * Ranges that cannot be in order (a range below the ones before it) go to one thread at
+ * once. */
+static void pair_apply_team(Team *team, const Pairs *p, int64_t parts, const int64_t *tops, const int32_t *row_of,
+                            uint16_t *values, uint8_t *fresh)
 {
     PairWrites *w = parts > 1 && parts <= MAX_PARTS ? malloc(sizeof *w) : NULL;
     int64_t before = 0;  /* the largest index the ranges before wrote + 1 */
     for (int64_t k = 0; w != NULL && k < parts; k++) {
-        if (tops[k] > 0 && lows[k] < before - 1) {
+        if (tops[k] > 0 && tops[k] < before) {
             free(w);
             w = NULL;
         } else {
-            w->shadow[k].index = tops[k] > 0 && lows[k] == before - 1 ? before - 1 : -1;
+            w->shadow[k].index = before - 1;
+            w->shadow[k].written = 0;
             before = tops[k] > before ? tops[k] : before;
         }
     }
-    if (w == NULL) {
+    if (w != NULL) {
+        w->p = p;
+        w->parts = parts;
+        w->row_of = row_of;
+        w->values = values;
+        w->fresh = fresh;
+        w->disorder = 0;
+        team_phase(team, pair_apply_range, w, parts);
+    }
+    if (w == NULL || w->disorder) {
         pair_apply(p, row_of, values, fresh, NULL);
+        free(w);
         return;
     }
-    w->p = p;
-    w->parts = parts;
-    w->row_of = row_of;
-    w->values = values;
-    w->fresh = fresh;
-    team_phase(team, pair_apply_range, w, parts);
     for (int64_t k = 0; k < parts; k++) {
         const PairShadow *sh = &w->shadow[k];
-        uint16_t *row = sh->index >= 0 ? values + 32 * (int64_t)row_of[sh->index] : NULL;
-        for (uint32_t bits = row != NULL ? sh->written : 0u; bits; bits &= bits - 1)
-            row[__builtin_ctz(bits)] = sh->row[__builtin_ctz(bits)];
+        for (uint32_t bits = sh->written; bits; bits &= bits - 1)
+            values[32 * (int64_t)row_of[sh->index] + __builtin_ctz(bits)] = sh->row[__builtin_ctz(bits)];
     }
     free(w);
 }
@@ -956,17 +964,17 @@ static int64_t mark_rows(const uint8_t *mark, int64_t top, int32_t *row_of, int6
 /* The pairs p to be written to an object table of `had` rows (index: sorted, each below
  * 2^19; values: PROP_WORDS words a row), the first of two calls (processor.py
  * _write_pairs): pair_marks over `parts` ranges of the pairs on a team, range k's result
- * into tops[k] and lows[k]; then the rows of the indices written merged with the table's
+ * into tops[k]; then the rows of the indices written merged with the table's
  * (mark_rows: row_of[i] the row of index i, merged the indices in order). When no index is
  * new, the writes (pair_apply_team) go to values in place here. mark (an index's flag, all
  * zero), row_of and merged are the caller's, 2^19 entries each. Returns the merged table's
  * rows: more than had when an index is new (then pairs_grow writes), mark being zero again
  * otherwise; -1 when a range holds a pair without its SD (tops[k] < 0 tells which), -2
  * when index is not strictly increasing: nothing written, the marks left to the caller. */
-int64_t pairs_rows(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, int64_t *tops, int64_t *lows,
-                   int32_t *row_of, int64_t *merged, const int64_t *index, int64_t had, uint16_t *values)
+int64_t pairs_rows(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, int64_t *tops, int32_t *row_of,
+                   int64_t *merged, const int64_t *index, int64_t had, uint16_t *values)
 {
-    pair_marks_team(team, p, parts, mark, tops, lows);
+    pair_marks_team(team, p, parts, mark, tops);
     int64_t top = 0;
     for (int64_t k = 0; k < parts; k++) {
         if (tops[k] < 0)
@@ -984,19 +992,19 @@ int64_t pairs_rows(Team *team, const Pairs *p, int64_t parts, uint8_t *mark, int
     int64_t rows = mark_rows(mark, top, row_of, merged);
     if (rows == had) {  /* no index is new */
         memset(mark, 0, (size_t)top);
-        pair_apply_team(team, p, parts, tops, lows, row_of, values, NULL);
+        pair_apply_team(team, p, parts, tops, row_of, values, NULL);
     }
     return rows;
 }
 
 /* The second call when pairs_rows found a new index, on the same team with the same
- * ranges and their tops and lows: the merged table of `rows` rows into index_out and
+ * ranges and their tops: the merged table of `rows` rows into index_out and
  * values_out, the old rows moved there and each new one zeroed as pair_apply first writes
  * it (every new index was marked by a pair that stores a word), then the writes
  * (pair_apply_team). mark is zero again on return. */
-void pairs_grow(Team *team, const Pairs *p, int64_t parts, const int64_t *tops, const int64_t *lows, uint8_t *mark,
-                const int32_t *row_of, const int64_t *merged, int64_t rows, const int64_t *index, int64_t had,
-                const uint16_t *values, int64_t *index_out, uint16_t *values_out)
+void pairs_grow(Team *team, const Pairs *p, int64_t parts, const int64_t *tops, uint8_t *mark, const int32_t *row_of,
+                const int64_t *merged, int64_t rows, const int64_t *index, int64_t had, const uint16_t *values,
+                int64_t *index_out, uint16_t *values_out)
 {
     memcpy(index_out, merged, (size_t)rows * sizeof *merged);
     for (int64_t i = 0; i < had; i++) {  /* the old rows move; the marks left are the new indices' */
@@ -1004,7 +1012,7 @@ void pairs_grow(Team *team, const Pairs *p, int64_t parts, const int64_t *tops, 
                PROP_WORDS * sizeof *values);
         mark[index[i]] = 0;
     }
-    pair_apply_team(team, p, parts, tops, lows, row_of, values_out, mark);
+    pair_apply_team(team, p, parts, tops, row_of, values_out, mark);
 }
 
 /* ---- rounding, for tests ---- */

@@ -264,8 +264,8 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
     (csrc/kernels.c pairs_rows, pairs_grow): over their words, the indices written and
     each pair decoded (in ranges of pairs on a team of ``jobs`` threads when there are
     many), the table's rows for them, then over the decoded pairs the writes: each range
-    of pairs on the thread that decoded it while the ranges write their indices in order,
-    else all in order on one thread (threads that each took a range of rows spent nearly as
+    of pairs most likely on the thread that decoded it while the ranges write their
+    indices in order, else all in order on one thread (threads that each took a range of rows spent nearly as
     long reading every pair as one thread writing them all). A new index gets a new table,
     its rows in index order, of the size it needs: the second call comes only then."""
     scratch, had, index = _SCRATCH, len(table.index), table.index

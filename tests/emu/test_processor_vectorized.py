@@ -7,6 +7,8 @@ same Execution or the same error message, and the same scene at every nf and at 
 
 from __future__ import annotations
 
+from contextlib import contextmanager, nullcontext
+
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
@@ -421,8 +423,11 @@ def test_pairs_back_to_back_decode_alike_on_both_instruction_sets(instruction_se
 
 
 #: Shapes in index order, as programs set them up: each index a step (0: the same index
-#: again, in a run of its own) above the one before, with its pairs (some store nothing).
-_ORDERED_SHAPES = st.lists(st.tuples(st.integers(0, 2), st.lists(st.tuples(_PROP, _PROP, _SD), min_size=1, max_size=9),
+#: again, in a run of its own) above the one before, with its pairs (half of them write
+#: property 0 twice, the shape table's null property: they store nothing).
+_STORES_NOTHING = st.builds(lambda sd: (0, 0, sd), _SD)
+_ORDERED_SHAPES = st.lists(st.tuples(st.integers(0, 2),
+                                     st.lists(st.tuples(_PROP, _PROP, _SD) | _STORES_NOTHING, min_size=1, max_size=9),
                                      st.booleans()), min_size=1, max_size=40)
 
 
@@ -437,20 +442,44 @@ def _ordered_words(first: int, shapes: list, gap: list[int], back: tuple[int, in
     return words
 
 
+@contextmanager
+def _teams_backwards():
+    """The processor's teams replaced by one whose leader alone runs each phase's tasks last
+    first (csrc/team.c team_open_backwards): the order that members taking every range
+    from the back would give, which a real team gives only now and then."""
+    from rend3r.emu import native, threads
+
+    @contextmanager
+    def backwards(jobs: int):
+        at = native.library().team_open_backwards()
+        try:
+            yield at
+        finally:
+            native.library().team_close(at)
+
+    real, threads.team = threads.team, backwards
+    try:
+        yield
+    finally:
+        threads.team = real
+
+
+@pytest.mark.parametrize("order", ["team", "backwards"])
 @pytest.mark.parametrize("instruction_set", ["base", "avx2"])
 @settings(max_examples=300)
 @given(st.integers(0, 1000), _ORDERED_SHAPES, _ORDERED_SHAPES, st.sampled_from([[], list(encode(CameraSet(1, 7)))]),
        st.none() | st.tuples(st.integers(0, 40), st.integers(1, 2)), st.integers(2, 4))
-def test_pairs_in_index_order_are_written_by_each_range_in_order(instruction_set, first, shapes, again, gap, back,
-                                                                 jobs):
+def test_pairs_in_index_order_are_written_by_each_range_in_order(order, instruction_set, first, shapes, again, gap,
+                                                                 back, jobs):
     """Pairs that write their indices in order are written range by range on several
     threads (csrc/kernels.c pair_apply_team), the writes to an index that ranges share
     (a shape whose pairs a range edge splits, or a range of one shape's pairs only) made in
     program order: the scenes of the reference interpreter, for a new table (pairs_grow) and
     for a second frame that writes, in order, to rows the table has (in place), with each
-    range's indices found a pair at a time and eight at a time (marks8). An index that goes
-    back by one or two (an earlier range may have written it) stops the ranges, and one
-    thread writes every pair again, in order, over what they wrote."""
+    range's indices found a pair at a time and eight at a time (marks8), on a team and with
+    the ranges run last first. An index that goes back by one or two lands, in some
+    examples, below the largest index the ranges before its own marked: that range stops,
+    and one thread writes every pair again, in order, over what the ranges wrote."""
     from rend3r.emu import native
 
     if not native.runs(instruction_set):
@@ -462,7 +491,8 @@ def test_pairs_in_index_order_are_written_by_each_range_in_order(instruction_set
     chunk, processor.PAIR_CHUNK = processor.PAIR_CHUNK, 2  # a few pairs a range: edges inside shapes
     native.choose(instruction_set)
     try:
-        got = _outcome(vectorized, words, options, None)
+        with _teams_backwards() if order == "backwards" else nullcontext():
+            got = _outcome(vectorized, words, options, None)
     finally:
         native.choose(None)
         processor.PAIR_CHUNK = chunk

@@ -822,8 +822,9 @@ static void pair_marks_team(Team *team, const Pairs *p, int64_t parts, uint8_t *
     team_phase(team, pair_range, &r, r.parts);
 }
 
-/* A range of pairs' writes to the largest index the ranges before it wrote (index; -1:
- * none), kept aside to be made after theirs: the words, and which were written. */
+/* A range of pairs' writes to the largest index the ranges before it marked (index; -1:
+ * none), kept aside to be made after theirs: the words (row, undefined where not
+ * written), and which were written (zero before the range writes). */
 typedef struct {
     int64_t index;
     uint32_t written;
@@ -837,13 +838,13 @@ typedef struct {
  * fresh (fresh[index] != 0; NULL: none) is zeroed as it is first written, and its flag
  * cleared: a pass of its own over a new table's rows took a tenth of the processor's time
  * at 65,536 spheres. With a shadow (NULL: none), the writes to shadow->index go to it
- * instead, and a pair whose index is below that one stops the writes: returns 0 then, 1
- * when every pair was written. */
+ * instead (shadow->written set when there were any), and a pair whose index is below that
+ * one stops the writes: returns 0 then, 1 when every pair was written. */
 static inline __attribute__((always_inline)) int pair_apply(const Pairs *p, const int32_t *row_of, uint16_t *values,
                                                             uint8_t *fresh, PairShadow *shadow)
 {
     const uint64_t *records = p->records;
-    int64_t n = p->n, last = -1, floor = shadow != NULL ? shadow->index : -1;
+    int64_t n = p->n, last = -1, shared = shadow != NULL ? shadow->index : -1;
     uint16_t *row = values;
     uint32_t written = 0;
     for (int64_t k = 0; k < n; k++) {
@@ -853,8 +854,8 @@ static inline __attribute__((always_inline)) int pair_apply(const Pairs *p, cons
         int64_t index = (int64_t)(r >> 12 & 0xFFFFFu);
         if (index != last) {
             last = index;
-            if (index <= floor) {
-                if (index < floor)
+            if (index <= shared) {
+                if (index < shared)
                     return 0;
                 row = shadow->row;
             } else {
@@ -865,14 +866,14 @@ static inline __attribute__((always_inline)) int pair_apply(const Pairs *p, cons
                 }
             }
         }
-        if (shadow != NULL && index == floor)
+        if (shadow != NULL && index == shared)
             written |= (r & 1u ? 1u << (r >> 7 & 31u) : 0u) | (r & 2u ? 1u << (r >> 2 & 31u) : 0u);
         if (r & 1u)
             row[r >> 7 & 31u] = (uint16_t)(r >> 48);
         if (r & 2u)
             row[r >> 2 & 31u] = (uint16_t)(r >> 32);
     }
-    if (shadow != NULL)
+    if (written)
         shadow->written = written;
     return 1;
 }
@@ -884,8 +885,8 @@ typedef struct {
     const int32_t *row_of;
     uint16_t *values;
     uint8_t *fresh;
-    int32_t disorder;  /* a range found an index below its shadow's */
-    PairShadow shadow[MAX_PARTS];
+    int32_t disorder;  /* a range met an index below its shadow's */
+    PairShadow shadow[];  /* one a range */
 } PairWrites;
 
 static void pair_apply_range(void *ctx, int64_t k)
@@ -899,22 +900,22 @@ static void pair_apply_range(void *ctx, int64_t k)
 
 /* pair_apply over the pairs p that pair_marks_team decoded in `parts` ranges (tops[k]:
  * range k's largest index marked + 1). Programs set their shapes up one after another, so
- * each range's indices mostly lie at or above the largest the ranges before it wrote:
- * then the ranges write on the team, each on the thread that most likely decoded it
- * (team.h: each thread keeps its end of the ranges), so its records and rows stay in that
- * thread's cache. The leader writing them all took 145 us at 4,096 spheres when the two
- * threads' cores had separate L3s, 33 on a shared L3 (docs/performance.md). A range's
+ * each range's indices mostly lie at or above the largest the ranges before it marked:
+ * then the ranges write on the team, each most likely on the thread that decoded it
+ * (team.h: each thread keeps its end of a pass's ranges), so its records and rows stay in
+ * that thread's cache. The leader writing them all took 145 us at 4,096 spheres when the
+ * two threads' cores had separate L3s, 33 on a shared L3 (docs/performance.md). A range's
  * writes to that largest index wait in its shadow and are made after the phase, range by
  * range, so the last write to a word still wins. A range that meets a lower index stops,
- * and one thread then writes every pair again, in order, over what the ranges wrote: the
+ * and the leader then writes every pair again, in order, over what the ranges wrote: the
  * last write to each word is the same, and a fresh row was zeroed before its first write.
- * Ranges that cannot be in order (a range below the ones before it) go to one thread at
- * once. */
+ * The leader writes them all at once, in order, when there is one range, when a range's
+ * indices all lie below the ones before it, or when the shadows' memory is refused. */
 static void pair_apply_team(Team *team, const Pairs *p, int64_t parts, const int64_t *tops, const int32_t *row_of,
                             uint16_t *values, uint8_t *fresh)
 {
-    PairWrites *w = parts > 1 && parts <= MAX_PARTS ? malloc(sizeof *w) : NULL;
-    int64_t before = 0;  /* the largest index the ranges before wrote + 1 */
+    PairWrites *w = parts > 1 ? malloc(sizeof *w + (size_t)parts * sizeof w->shadow[0]) : NULL;
+    int64_t before = 0;  /* the largest index the ranges before marked + 1 */
     for (int64_t k = 0; w != NULL && k < parts; k++) {
         if (tops[k] > 0 && tops[k] < before) {
             free(w);

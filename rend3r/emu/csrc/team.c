@@ -34,9 +34,8 @@ void team_close(Team *t)
 
 void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
 {
-    (void)t;
     for (int64_t k = 0; k < tasks; k++)
-        fn(ctx, k);
+        fn(ctx, t->backwards ? tasks - 1 - k : k);
 }
 #else
 #include <pthread.h>
@@ -158,9 +157,10 @@ static void team_member(Team *t, const TeamCpus *c)
 
 void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
 {
-    if (tasks <= 1 || tasks > TEAM_TASKS) {  /* nothing to share, or more than a claim counts (no pass asks) */
+    if (tasks <= 1 || tasks > TEAM_TASKS || t->backwards) {  /* nothing to share, more than a claim counts
+                                                                 (no pass asks), or a test's team */
         for (int64_t k = 0; k < tasks; k++)
-            fn(ctx, k);
+            fn(ctx, t->backwards ? tasks - 1 - k : k);
         return;
     }
     int64_t p = ++t->phases;
@@ -285,7 +285,27 @@ void team_close(Team *t)
 }
 #endif
 
-/* ---- a check of the protocol for tests (tests/emu/test_threads.py) ---- */
+/* ---- for tests ---- */
+
+/* A team without members whose leader runs each phase's tasks last first, as if members
+ * had taken them all from the back before the leader took one: a pass whose result must
+ * not depend on which thread ran which task, or when, gets the order threads make least
+ * often (tests/emu/test_processor_vectorized.py). Closed with team_close. */
+Team *team_open_backwards(void)
+{
+    Team *t = calloc(1, sizeof *t);
+    if (t == NULL)
+        return NULL;
+#if !TEAM_SOLO
+    atomic_init(&t->refs, 1);
+    atomic_init(&t->leader_cpu, -1);
+#endif
+    t->size = 1;
+    t->backwards = 1;
+    return t;
+}
+
+/* A check of the protocol (tests/emu/test_threads.py). */
 
 static _Thread_local char team_here;  /* its address tells the threads apart */
 

@@ -57,6 +57,7 @@ typedef struct {
     TEAM_ATOMIC(int32_t) refs;      /* the leader until it closes the team, and each member inside it */
     TEAM_ATOMIC(int32_t) leader_cpu;  /* the CPU the leader released its last phase on (-1: not known) */
     int32_t size;                   /* the leader and the members it was opened for */
+    int32_t backwards;              /* tests: the leader alone runs each phase's tasks, last first (team.c) */
     TeamPhase ring[TEAM_RING];
 } Team;
 

@@ -265,9 +265,10 @@ def _write_pairs(words: np.ndarray, at: np.ndarray, tables: np.ndarray | None, e
     each pair decoded (in ranges of pairs on a team of ``jobs`` threads when there are
     many), the table's rows for them, then over the decoded pairs the writes: each range
     of pairs most likely on the thread that decoded it while the ranges write their
-    indices in order, else all in order on one thread (threads that each took a range of rows spent nearly as
-    long reading every pair as one thread writing them all). A new index gets a new table,
-    its rows in index order, of the size it needs: the second call comes only then."""
+    indices in order, else all in order on one thread (threads that each took a range of
+    rows spent nearly as long reading every pair as one thread writing them all). A new
+    index gets a new table, its rows in index order, of the size it needs: the second call
+    comes only then."""
     scratch, had, index = _SCRATCH, len(table.index), table.index
     if had and not (0 <= index[0] and index[-1] < SHAPE_INDEX_LIMIT):
         raise ValueError(f"object table indices must lie in 0..{SHAPE_INDEX_LIMIT - 1}")

@@ -168,3 +168,38 @@ def test_every_task_of_every_phase_runs_once_on_a_team(jobs):
     slots is reused; each task runs exactly once. In a process of its own, so that a
     hang (a task counted in the wrong phase's slot) shows as a timeout."""
     subprocess.run([sys.executable, "-c", _CHECK_RUNS, str(jobs)], check=True, timeout=120, cwd=ROOT)
+
+
+#: Teams of sys.argv[1] threads, each opened a pause after the last one closed, running
+#: phases through team_check_runs until members have taken tasks in ten teams of each
+#: pause: within the time a pool thread waits spinning after a team (csrc/team.c
+#: POOL_LINGER_NS), and past it, when it sleeps and team_open must wake it.
+_TEAMS_AFTER_PAUSES = """
+import sys, time
+import numpy as np
+from rend3r.emu import native, threads
+lib = native.library()
+tasks = np.array([64] * 50, dtype=np.int64)
+for pause in (0.0, 0.00005, 0.005):
+    joined = 0
+    for _ in range(2000):
+        time.sleep(pause)
+        runs = np.zeros(int(tasks.sum()), dtype=np.int32)
+        with threads.team(int(sys.argv[1])) as at:
+            lib.team_check_runs(at, native.address(tasks), len(tasks), native.address(runs))
+        assert (runs % 256 == 1).all(), "a task ran more or less than once"
+        joined += bool((runs >= 256).any())
+        if joined == 10:
+            break
+    assert joined == 10, f"members joined only {joined} teams opened {pause * 1e3} ms after the last"
+"""
+
+
+@pytest.mark.skipif(threads.available_cores() < 2, reason="needs two CPUs for the members to take tasks")
+@pytest.mark.parametrize("jobs", [2, 3])
+def test_members_join_teams_opened_at_once_or_after_they_sleep(jobs):
+    """A pool thread that leaves a team waits spinning for the next one, then sleeps: a
+    team opened as the last closes, a little later, or long after (team_open then wakes
+    the thread) gets its members, and each task runs once. In a process of its own, so
+    that a lost wake-up shows as a failure, not as a pool stuck for later tests."""
+    subprocess.run([sys.executable, "-c", _TEAMS_AFTER_PAUSES, str(jobs)], check=True, timeout=120, cwd=ROOT)

@@ -2,8 +2,9 @@
  * threads that join teams.
  *
  * The members are threads of this library, not Python threads: they never take the GIL,
- * so joining a team and leaving it costs the leader nothing but a wake-up call. They are
- * started the first time a team asks for them and then sleep between teams.
+ * so joining a team and leaving it costs the leader at most a wake-up call. They are
+ * started the first time a team asks for them; between teams they wait spinning for a
+ * while, then sleep.
  *
  * A team's memory is the library's: it goes when the leader has closed the team and every
  * member has left it (refs), so closing never waits for a member. A busy host may stop a
@@ -13,10 +14,11 @@
 #if defined(__linux__) && !defined(_GNU_SOURCE)
 #define _GNU_SOURCE  /* sched_getcpu and CPU sets (team_apart) */
 #endif
-#define _POSIX_C_SOURCE 200809L  /* pthread_sigmask, sched_yield under -std=c11 */
+#define _POSIX_C_SOURCE 200809L  /* pthread_sigmask, sched_yield, clock_gettime under -std=c11 */
 
 #include <stdint.h>
 #include <stdlib.h>
+#include <time.h>
 
 #include "team.h"
 
@@ -179,23 +181,50 @@ void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
 
 /* The pool: one team at a time. Its threads sleep on wake until a team is opened for
  * them (the first `wanted` threads join it), and hold a reference to it while they are
- * members. */
+ * members. A thread the last team wanted waits spinning for the next one for
+ * POOL_LINGER_NS before it sleeps, as OpenMP runtimes do between parallel regions, and
+ * again after each team it saw opened but could not join (it had ended): a team opened
+ * meanwhile (a program's next run) is joined without a wake-up call, which cost
+ * team_open some 8 us of the 10 it took (benchmarks/bench_team.py). */
 #define POOL_LIMIT 256
+#define POOL_LINGER_NS 200000
 static pthread_mutex_t pool_lock = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t pool_wake = PTHREAD_COND_INITIALIZER;
 static struct {
     int32_t started;   /* threads started */
-    int32_t wanted;    /* of them, members of the open team */
+    int32_t wanted;    /* of them, members of the open team (or of the last, once it has ended) */
+    int32_t sleeping;  /* of them, waiting on pool_wake */
     int64_t opened;    /* teams opened so far (a thread joins each at most once) */
     Team *team;        /* the open team, NULL: none */
     int32_t forks;     /* set up pthread_atfork once */
 } pool;
+static TEAM_ATOMIC(int64_t) pool_opened;  /* pool.opened, for threads that spin without the lock */
 
 /* Drops a reference to t; the last one frees it. */
 static void team_release(Team *t)
 {
     if (atomic_fetch_sub_explicit(&t->refs, 1, memory_order_acq_rel) == 1)
         free(t);
+}
+
+static int64_t pool_now_ns(void)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return (int64_t)now.tv_sec * 1000000000 + now.tv_nsec;
+}
+
+/* Waits spinning until a team is opened after the `seen`th (returns 1), or
+ * POOL_LINGER_NS have passed (returns 0). */
+static int pool_linger(int64_t seen)
+{
+    int64_t spins = 0, until = pool_now_ns() + POOL_LINGER_NS;
+    while (atomic_load_explicit(&pool_opened, memory_order_relaxed) == seen) {
+        team_wait(&spins);  /* yields the core after a while: a team may have more threads than cores */
+        if (spins % 64 == 0 && pool_now_ns() > until)
+            return 0;
+    }
+    return 1;
 }
 
 static void *pool_thread(void *arg)
@@ -206,8 +235,19 @@ static void *pool_thread(void *arg)
     team_cpus(&cpus);
     pthread_mutex_lock(&pool_lock);
     for (;;) {
-        while (!(pool.team != NULL && pool.opened != seen && index < pool.wanted))
+        while (!(pool.team != NULL && pool.opened != seen && index < pool.wanted)) {
+            if (index < pool.wanted) {  /* wanted by the last team, which has ended (or is ending) */
+                int64_t last = pool.opened;
+                pthread_mutex_unlock(&pool_lock);
+                int opened = pool_linger(last);
+                pthread_mutex_lock(&pool_lock);
+                if (opened)
+                    continue;  /* join it, or, if it has ended already, linger again */
+            }
+            pool.sleeping++;
             pthread_cond_wait(&pool_wake, &pool_lock);
+            pool.sleeping--;
+        }
         Team *t = pool.team;
         seen = pool.opened;
         atomic_fetch_add_explicit(&t->refs, 1, memory_order_relaxed);  /* under the lock: t is open, its leader's */
@@ -224,8 +264,9 @@ static void pool_after_fork(void)
 {
     pthread_mutex_init(&pool_lock, NULL);
     pthread_cond_init(&pool_wake, NULL);
-    pool.started = pool.wanted = 0;
+    pool.started = pool.wanted = pool.sleeping = 0;
     pool.team = NULL;
+    atomic_store_explicit(&pool_opened, pool.opened, memory_order_relaxed);
 }
 
 /* Opens a team with up to `members` threads of the pool beside the caller, who leads it;
@@ -248,26 +289,29 @@ Team *team_open(int32_t members)
         pthread_mutex_unlock(&pool_lock);
         return t;
     }
-    sigset_t all, before;  /* the pool's threads block every signal: the process's threads take them */
-    sigfillset(&all);
-    pthread_sigmask(SIG_SETMASK, &all, &before);
-    while (pool.started < members) {
-        pthread_t thread;
-        pthread_attr_t attr;
-        pthread_attr_init(&attr);
-        pthread_attr_setdetachstate(&attr, PTHREAD_CREATE_DETACHED);
-        int failed = pthread_create(&thread, &attr, pool_thread, (void *)(intptr_t)pool.started);
-        pthread_attr_destroy(&attr);
-        if (failed)
-            break;
-        pool.started++;
+    if (pool.started < members) {
+        sigset_t all, before;  /* the pool's threads block every signal: the process's threads take them */
+        sigfillset(&all);
+        pthread_sigmask(SIG_SETMASK, &all, &before);
+        while (pool.started < members) {
+            pthread_t thread;
+            pthread_attr_t attr;
+            pthread_attr_init(&attr);
+            pthread_attr_setdetachstate(&attr, PTHREAD_CREATE_DETACHED);
+            int failed = pthread_create(&thread, &attr, pool_thread, (void *)(intptr_t)pool.started);
+            pthread_attr_destroy(&attr);
+            if (failed)
+                break;
+            pool.started++;
+        }
+        pthread_sigmask(SIG_SETMASK, &before, NULL);
     }
-    pthread_sigmask(SIG_SETMASK, &before, NULL);
     pool.wanted = members < pool.started ? members : pool.started;
     t->size = 1 + pool.wanted;  /* read by the members after the lock below */
     pool.team = t;
-    pool.opened++;
-    pthread_cond_broadcast(&pool_wake);
+    atomic_store_explicit(&pool_opened, ++pool.opened, memory_order_relaxed);
+    if (pool.sleeping > 0)  /* those spinning see pool_opened */
+        pthread_cond_broadcast(&pool_wake);
     pthread_mutex_unlock(&pool_lock);
     return t;
 }

@@ -179,9 +179,9 @@ void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
         team_wait(&spins);
 }
 
-/* The pool: one team at a time. Its threads sleep on wake until a team is opened for
- * them (the first `wanted` threads join it), and hold a reference to it while they are
- * members. A thread the last team wanted waits spinning for the next one for
+/* The pool: one team at a time. Its threads wait until a team is opened for them (the
+ * first `wanted` threads join it), and hold a reference to it while they are members.
+ * A thread the last team wanted waits spinning for the next one for
  * POOL_LINGER_NS before it sleeps, as OpenMP runtimes do between parallel regions, and
  * again after each team it saw opened but could not join (it had ended): a team opened
  * meanwhile (a program's next run) is joined without a wake-up call, which cost
@@ -214,17 +214,16 @@ static int64_t pool_now_ns(void)
     return (int64_t)now.tv_sec * 1000000000 + now.tv_nsec;
 }
 
-/* Waits spinning until a team is opened after the `seen`th (returns 1), or
- * POOL_LINGER_NS have passed (returns 0). */
-static int pool_linger(int64_t seen)
+/* Waits spinning until a team is opened after the `seen`th, or POOL_LINGER_NS have
+ * passed. */
+static void pool_linger(int64_t seen)
 {
     int64_t spins = 0, until = pool_now_ns() + POOL_LINGER_NS;
     while (atomic_load_explicit(&pool_opened, memory_order_relaxed) == seen) {
         team_wait(&spins);  /* yields the core after a while: a team may have more threads than cores */
-        if (spins % 64 == 0 && pool_now_ns() > until)
-            return 0;
+        if ((spins % 64 == 0 || spins >= 2048) && pool_now_ns() > until)  /* each yield may take long */
+            return;
     }
-    return 1;
 }
 
 static void *pool_thread(void *arg)
@@ -239,10 +238,12 @@ static void *pool_thread(void *arg)
             if (index < pool.wanted) {  /* wanted by the last team, which has ended (or is ending) */
                 int64_t last = pool.opened;
                 pthread_mutex_unlock(&pool_lock);
-                int opened = pool_linger(last);
+                pool_linger(last);
                 pthread_mutex_lock(&pool_lock);
-                if (opened)
-                    continue;  /* join it, or, if it has ended already, linger again */
+                if (pool.opened != last)  /* opened while it waited, or as the wait ran out (no wake-up
+                                             comes then): join it; if it has ended, wait again; if it
+                                             does not want this thread, sleep */
+                    continue;
             }
             pool.sleeping++;
             pthread_cond_wait(&pool_wake, &pool_lock);
@@ -310,7 +311,7 @@ Team *team_open(int32_t members)
     t->size = 1 + pool.wanted;  /* read by the members after the lock below */
     pool.team = t;
     atomic_store_explicit(&pool_opened, ++pool.opened, memory_order_relaxed);
-    if (pool.sleeping > 0)  /* those spinning see pool_opened */
+    if (pool.sleeping > 0)  /* the others see pool_opened, or pool.opened once they hold the lock */
         pthread_cond_broadcast(&pool_wake);
     pthread_mutex_unlock(&pool_lock);
     return t;

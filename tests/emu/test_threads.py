@@ -91,7 +91,8 @@ _SPLIT_WALL = (
 
 def test_a_forked_child_starts_its_own_team_threads():
     """The pool's threads do not survive a fork: a child that renders with two jobs starts
-    its own, and gets the frames its parent gets with one."""
+    its own, and gets the frames its parent gets with one; the parent's pool serves it
+    after the fork as before (a fork holds the pool's lock while it copies the process)."""
     code = _SPLIT_WALL + (
         "frame = lambda j: run_program(w.words, EmuOptions(precision='fp32', jobs=j, width=64, height=48)).frames[0]\n"
         "one = frame(1).rgb565.tobytes()\n"
@@ -99,7 +100,8 @@ def test_a_forked_child_starts_its_own_team_threads():
         "pid = os.fork()\n"
         "if pid == 0:\n"
         "    os._exit(0 if frame(2).rgb565.tobytes() == one else 1)\n"
-        "assert os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]) == 0\n")
+        "assert os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]) == 0\n"
+        "assert frame(2).rgb565.tobytes() == one\n")
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60, cwd=ROOT)
 
 

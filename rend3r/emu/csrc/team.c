@@ -260,8 +260,19 @@ static void *pool_thread(void *arg)
     return NULL;
 }
 
-/* In a forked child only the forking thread exists: the pool starts afresh. */
-static void pool_after_fork(void)
+/* A fork waits until no thread holds the pool's lock, so that the child's copy of the
+ * pool is whole; in the child only the forking thread exists: the pool starts afresh. */
+static void pool_before_fork(void)
+{
+    pthread_mutex_lock(&pool_lock);
+}
+
+static void pool_after_fork_parent(void)
+{
+    pthread_mutex_unlock(&pool_lock);
+}
+
+static void pool_after_fork_child(void)
 {
     pthread_mutex_init(&pool_lock, NULL);
     pthread_cond_init(&pool_wake, NULL);
@@ -283,7 +294,7 @@ Team *team_open(int32_t members)
     members = members < 0 ? 0 : members > POOL_LIMIT ? POOL_LIMIT : members;
     pthread_mutex_lock(&pool_lock);
     if (!pool.forks) {
-        pthread_atfork(NULL, NULL, pool_after_fork);
+        pthread_atfork(pool_before_fork, pool_after_fork_parent, pool_after_fork_child);
         pool.forks = 1;
     }
     if (pool.team != NULL || members == 0) {

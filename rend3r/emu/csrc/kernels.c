@@ -943,7 +943,7 @@ static void pair_apply_team(Team *team, const Pairs *p, int64_t parts, const int
     for (int64_t k = 0; k < parts; k++) {
         const PairShadow *sh = &w->shadow[k];
         for (uint32_t bits = sh->written; bits; bits &= bits - 1)
-            values[32 * (int64_t)row_of[sh->index] + __builtin_ctz(bits)] = sh->row[__builtin_ctz(bits)];
+            values[PROP_WORDS * (int64_t)row_of[sh->index] + __builtin_ctz(bits)] = sh->row[__builtin_ctz(bits)];
     }
     free(w);
 }

@@ -43,11 +43,13 @@ void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
 #include <pthread.h>
 #include <signal.h>
 
-/* Waits a little (the other threads run on other cores), then yields the core: a team of
- * more threads than cores must not spin against its own leader. */
+/* Waits a little (the other threads run on other cores), then, after TEAM_SPINS calls,
+ * yields the core at each: a team of more threads than cores must not spin against its
+ * own leader. */
+#define TEAM_SPINS 2048
 static inline void team_wait(int64_t *spins)
 {
-    if (++*spins < 2048) {
+    if (++*spins < TEAM_SPINS) {
 #if defined(__x86_64__) || defined(__i386__)
         __builtin_ia32_pause();
 #endif
@@ -221,7 +223,7 @@ static void pool_linger(int64_t seen)
     int64_t spins = 0, until = pool_now_ns() + POOL_LINGER_NS;
     while (atomic_load_explicit(&pool_opened, memory_order_relaxed) == seen) {
         team_wait(&spins);  /* yields the core after a while: a team may have more threads than cores */
-        if ((spins % 64 == 0 || spins >= 2048) && pool_now_ns() > until)  /* each yield may take long */
+        if ((spins % 64 == 0 || spins >= TEAM_SPINS) && pool_now_ns() > until)  /* a yield may take long */
             return;
     }
 }

@@ -19,6 +19,18 @@ import time
 import numpy as np
 
 from rend3r.emu import native, threads
+from two_cpus import _at_least
+
+#: The longest pause a case may ask for (each of its teams waits it out).
+LONGEST_PAUSE_MS = 100.0
+
+
+def _pause(text: str) -> float:
+    """An argparse type: a pause in ms, 0 to LONGEST_PAUSE_MS."""
+    value = float(text)
+    if not 0.0 <= value <= LONGEST_PAUSE_MS:
+        raise argparse.ArgumentTypeError(f"{text} ms is outside 0..{LONGEST_PAUSE_MS:g}")
+    return value
 
 
 def _teams(count: int, pause: float) -> tuple[float, float]:
@@ -44,8 +56,8 @@ def _teams(count: int, pause: float) -> tuple[float, float]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--teams", type=int, default=2000, help="teams per case; medians are reported")
-    ap.add_argument("--pauses-ms", type=float, nargs="+", default=[0.0, 0.05, 0.1, 0.5, 2.0],
+    ap.add_argument("--teams", type=_at_least(1), default=2000, help="teams per case; medians are reported")
+    ap.add_argument("--pauses-ms", type=_pause, nargs="+", default=[0.0, 0.05, 0.1, 0.5, 2.0],
                     help="pauses before each team, one case each (the longest is the baseline)")
     args = ap.parse_args()
     if threads.available_cores() < 2:

@@ -15,7 +15,7 @@ processes (two_cpus.py) mostly do not:
   threads from pass to pass: ``--jobs 2`` measured 1.57x.
 
 (Medians over 8,393 rounds of three frames each way at 4,096 spheres, fp32, 2026-12-04;
-docs/performance.md.) The kinds are told apart by the ratio of the two reads, so that
+docs/performance-history.md.) The kinds are told apart by the ratio of the two reads, so that
 they do not depend on this machine's clock; the cuts between them are set from this
 EPYC's figures (ratios of about 1-1.8, 2.4-5.3 and 9.6-23), and another design (a mesh
 of cores sharing one L3, say) may need others.

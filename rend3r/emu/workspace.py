@@ -7,7 +7,7 @@ lists whose pages are mostly never touched). Allocated afresh each time, glibc w
 default thresholds gives them back to the kernel when they are freed (it trims the
 heap's top and unmaps large blocks), and the next run pays a page fault and a zeroed
 page for every 4 KiB it touches again: more than half of a 65,536-sphere run
-(``docs/performance.md``, "Working memory kept"). The ``rend3r`` command, the benchmarks
+(``docs/performance-history.md``, "Working memory kept"). The ``rend3r`` command, the benchmarks
 and Dask workers raise those thresholds for the whole process (``rend3r/memory.py``), a
 choice a library must not make for the program that imports it; :func:`empty` keeps
 these arrays' memory in buffers of its own, per thread, so ``run_program`` called from

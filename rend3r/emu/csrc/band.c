@@ -44,7 +44,7 @@ typedef struct {
  * together, where equal parts left one waiting up to a part's time at the end of each
  * pass. Since the leader takes from the front and the members from the back (team.c
  * team_take), the parts met last are mid-sized; parts shrinking towards where the two
- * ends meet measured no faster (docs/performance.md, "The night of 2026-12-04"). */
+ * ends meet measured no faster (docs/performance-history.md, "The night of 2026-12-04"). */
 static inline int64_t taper(int64_t n, int64_t parts, int64_t k)
 {
     return (4 * n * k * parts + 3 * n * k * (parts - k)) / (4 * parts * parts);

@@ -165,7 +165,7 @@ static inline void put(int32_t *at, int32_t v, int32_t keep)
  * aligned) holds the working copies. With keep (other threads read the tree), items,
  * always and node are written only where they differ: the tree depends on the centres
  * alone, and a frame whose shapes did not move then leaves the last frame's in the other
- * threads' caches (docs/performance.md, "Rows left alone"). Returns the node count. */
+ * threads' caches (docs/performance-history.md, "Rows left alone"). Returns the node count. */
 int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
                   int32_t *node, int64_t *count_out, void *room, int32_t keep)
 {
@@ -904,7 +904,7 @@ static void pair_apply_range(void *ctx, int64_t k)
  * then the ranges write on the team, each most likely on the thread that decoded it
  * (team.h: each thread keeps its end of a pass's ranges), so its records and rows stay in
  * that thread's cache. The leader writing them all took 145 us at 4,096 spheres when the
- * two threads' cores had separate L3s, 33 on a shared L3 (docs/performance.md). A range's
+ * two threads' cores had separate L3s, 33 on a shared L3 (docs/performance-history.md). A range's
  * writes to that largest index wait in its shadow and are made after the phase, range by
  * range, so the last write to a word still wins. A range that meets a lower index stops,
  * and the leader then writes every pair again, in order, over what the ranges wrote: the

@@ -152,7 +152,7 @@ static void subtrees(const int32_t *node, int64_t nodes, int64_t want, Subtrees 
 /* The bundle's items and refit, after its radii are known: subtrees side by side, each
  * with its items (a pass of its own over the items, in even ranges, lost 25 us a frame at
  * 4,096 spheres when the two threads' cores had separate L3s: each thread then read item
- * bounds the other had made; docs/performance.md), then the nodes above them. */
+ * bounds the other had made; docs/performance-history.md), then the nodes above them. */
 static void bundle_tree(Bundle *b, Team *team)
 {
     int64_t parts = shape_parts(b->items, b->jobs, b->chunk);

@@ -53,7 +53,8 @@ Progress = Callable[[float], None]
 BAND_PIXELS = native.BAND_LIMIT
 #: Pixels per band at least, and per shape and bundle of rays more (_band_rows).
 BAND_LEAST, BAND_PER_SHAPE = 1 << 14, 64
-#: Smallest chunk of pixels handed to a thread, and the most chunks a pass takes per thread.
+#: Smallest chunk of pixels handed to a thread (a quarter of it where a pass would give a
+#: thread fewer than eight: csrc/band.c pixel_parts), and the most chunks a pass takes per thread.
 MIN_CHUNK = 1 << 12
 CHUNKS_PER_JOB = 32
 _CHANNELS = ((11, 31), (5, 63), (0, 31))  # RGB565: (shift, largest value) per channel

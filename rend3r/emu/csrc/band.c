@@ -154,12 +154,32 @@ static size_t lay_out(Bands *f, Work *w, char *base, int64_t npix)
     return at;
 }
 
-/* fn over 0..n (block its argument) in chunks at least smallest long, each adding to its
- * own copy of the report row init (width doubles); out gets the rows merged. */
+/* Chunks a thread gets of a pixel pass at least, where the pass is long enough for chunks
+ * of a quarter of the smallest: a lit band of few shapes (some 16,384 pixels) made four
+ * chunks of the smallest for two threads, and each of its passes ended with one thread
+ * waiting out the other's last chunk (`--jobs 2` at 16 and 256 spheres 1.5x, 1.7x with
+ * chunks a quarter as long; docs/performance.md). Longer passes keep their chunks. */
+#define CHUNKS_LEAST 8
+
+/* How many chunks a pixel pass over 0..n takes on f's team: up to chunks_per_job a thread,
+ * none shorter than smallest, or than a quarter of it where that gives the threads up to
+ * CHUNKS_LEAST each (team.h parts_of). */
+static int64_t pixel_parts(const Bands *f, int64_t n, int64_t smallest)
+{
+    int64_t parts = parts_of(n, f->jobs, smallest, f->chunks_per_job), least = CHUNKS_LEAST * (int64_t)f->jobs;
+    if (parts < least) {
+        int64_t finer = parts_of(n, f->jobs, MAX(1, smallest / 4), f->chunks_per_job);
+        parts = MAX(parts, MIN(finer, least));
+    }
+    return parts;
+}
+
+/* fn over 0..n (block its argument) in chunks (pixel_parts), each adding to its own copy
+ * of the report row init (width doubles); out gets the rows merged. */
 static void run(const Bands *f, Team *team, Work *w, ChunkFn fn, const void *block, int64_t n, int64_t smallest,
                 const double *init, int width, void (*merge)(double *, const double *), double *out)
 {
-    int64_t parts = parts_of(n, f->jobs, smallest, f->chunks_per_job);
+    int64_t parts = pixel_parts(f, n, smallest);
     parts = parts < w->capacity ? parts : w->capacity;
     for (int64_t k = 0; k < parts; k++)
         memcpy(w->rows + ROW * k, init, sizeof(double) * (size_t)width);

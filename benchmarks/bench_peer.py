@@ -20,12 +20,14 @@ llvm_ad_rgb, fp16 at most 1x scalar_rgb's, at every size; 16x more spheres (4,09
 at most 3x the time (pinned, the two sizes alternating round by round); jobs=2 at least
 1.7x faster than jobs=1 at 4,096 spheres (unpinned, alternating likewise; each round also
 measures what two pinned single-thread processes get from the two CPUs in those seconds,
-two_cpus.py, the most a jobs=2 frame could gain then).
+two_cpus.py, the most a jobs=2 frame could gain then). --jobs-sizes picks the sizes of
+that part (default 4,096 and 65,536; 16 and 256 show the frames of a few bands).
 Exit status 0, except 1 when an fp32 frame is not faithful to fp64 (a bug).
 
     python benchmarks/bench_peer.py [--sizes 1 16 256 4096 65536] [--runs 5]
                                     [--peer scalar_rgb llvm_ad_rgb | --no-peer]
                                     [--plot PATH] [--markdown PATH]
+                                    [--jobs-sizes 4096 65536]
 """
 
 from __future__ import annotations
@@ -226,9 +228,9 @@ def scaling(sizes: list[int], runs: int) -> list[str]:
     return lines
 
 
-def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
-    """jobs=1 against jobs=2 at JOBS_SIZE and JOBS_ALSO spheres, on the unpinned process,
-    printing as it goes. The two alternate round by round, so that a drift of the machine's
+def jobs_scaling(runs: int, cpus: set[int], sizes: list[int]) -> list[str]:
+    """jobs=1 against jobs=2 at each of ``sizes`` spheres (the target at JOBS_SIZE), on the
+    unpinned process, printing as it goes. The two alternate round by round, so that a drift of the machine's
     speed falls on both; in a round each renders WARM_FRAMES frames untimed (its threads
     and caches warm, as in a run of frames: on this VM the first two jobs=2 frames after
     jobs=1 frames run 20-30% slow while the idle second vCPU wakes) and one timed. The
@@ -244,7 +246,7 @@ def jobs_scaling(runs: int, cpus: set[int]) -> list[str]:
         return [line]
     lines = []
     unplaced = placement.available()
-    for size in (JOBS_SIZE, JOBS_ALSO):
+    for size in sizes:
         wall = walls.wall(size, lights=1)
         for precision in ("fp32", "fp16"):
             options = {jobs: EmuOptions(precision=precision, width=WIDTH, height=HEIGHT, jobs=jobs) for jobs in (1, 2)}
@@ -414,6 +416,8 @@ def main() -> int:
     ap.add_argument("--no-peer", action="store_true", help="skip Mitsuba")
     ap.add_argument("--plot", type=Path, help="write a log-log PNG of time against spheres")
     ap.add_argument("--markdown", type=Path, help="write the results as Markdown")
+    ap.add_argument("--jobs-sizes", type=int, nargs="+", default=[JOBS_SIZE, JOBS_ALSO], choices=SIZES,
+                    help="sizes of the jobs=1 against jobs=2 part (its target is at 4,096)")
     args = ap.parse_args()
     command = shlex.join(["python", "benchmarks/bench_peer.py", *sys.argv[1:]])
     cpus = os.sched_getaffinity(0)
@@ -445,7 +449,7 @@ def main() -> int:
     print()
     notes = scaling(sorted(args.sizes), args.runs)
     os.sched_setaffinity(0, cpus)  # unpinned: the jobs=2 threads start after this and inherit it
-    notes += jobs_scaling(args.runs, cpus)
+    notes += jobs_scaling(args.runs, cpus, list(dict.fromkeys(args.jobs_sizes)))
     if args.markdown:
         header_md = [f"Measured by `{command}`.", "", f"- {calibration}", f"- {header[1]}"]
         args.markdown.parent.mkdir(parents=True, exist_ok=True)

@@ -155,15 +155,16 @@ static size_t lay_out(Bands *f, Work *w, char *base, int64_t npix)
 }
 
 /* Chunks a thread gets of a pixel pass at least, where the pass is long enough for chunks
- * of a quarter of the smallest: a lit band of few shapes (some 16,384 pixels) made four
- * chunks of the smallest for two threads, and each of its passes ended with one thread
- * waiting out the other's last chunk (`--jobs 2` at 16 and 256 spheres 1.5x, 1.7x with
- * chunks a quarter as long; docs/performance.md). Longer passes keep their chunks. */
+ * averaging a quarter of the smallest: a lit band of few shapes (some 16,384 pixels) made
+ * four chunks for two threads, and each of its passes ended with one thread waiting out
+ * the other's last chunk (`--jobs 2` at 16 and 256 spheres 1.5x, 1.7x with chunks a
+ * quarter as long; docs/performance.md). Longer passes keep their chunks. */
 #define CHUNKS_LEAST 8
 
-/* How many chunks a pixel pass over 0..n takes on f's team: up to chunks_per_job a thread,
- * none shorter than smallest, or than a quarter of it where that gives the threads up to
- * CHUNKS_LEAST each (team.h parts_of). */
+/* How many chunks a pixel pass over 0..n takes on f's team (team.h parts_of): up to
+ * chunks_per_job a thread, averaging at least smallest; where that gives a thread fewer
+ * than CHUNKS_LEAST, up to CHUNKS_LEAST a thread averaging at least a quarter of it
+ * (chunk_task tapers them). */
 static int64_t pixel_parts(const Bands *f, int64_t n, int64_t smallest)
 {
     int64_t parts = parts_of(n, f->jobs, smallest, f->chunks_per_job), least = CHUNKS_LEAST * (int64_t)f->jobs;

@@ -168,10 +168,8 @@ static size_t lay_out(Bands *f, Work *w, char *base, int64_t npix)
 static int64_t pixel_parts(const Bands *f, int64_t n, int64_t smallest)
 {
     int64_t parts = parts_of(n, f->jobs, smallest, f->chunks_per_job), least = CHUNKS_LEAST * (int64_t)f->jobs;
-    if (parts < least) {
-        int64_t finer = parts_of(n, f->jobs, MAX(1, smallest / 4), f->chunks_per_job);
-        parts = MAX(parts, MIN(finer, least));
-    }
+    if (parts < least)  /* finer chunks are never fewer */
+        parts = MIN(parts_of(n, f->jobs, smallest / 4, f->chunks_per_job), least);
     return parts;
 }
 

@@ -351,15 +351,9 @@ void team_close(Team *t)
  * often (tests/emu/test_processor_vectorized.py). Closed with team_close. */
 Team *team_open_backwards(void)
 {
-    Team *t = calloc(1, sizeof *t);
-    if (t == NULL)
-        return NULL;
-#if !TEAM_SOLO
-    atomic_init(&t->refs, 1);
-    atomic_init(&t->leader_cpu, -1);
-#endif
-    t->size = 1;
-    t->backwards = 1;
+    Team *t = team_open(0);
+    if (t != NULL)
+        t->backwards = 1;
     return t;
 }
 

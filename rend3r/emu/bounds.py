@@ -37,6 +37,7 @@ class Pass:
     radius: np.ndarray  # cull radius per shape
     floor: np.ndarray | None = None  # primary rays: depth floor per shape
     pc: np.ndarray | None = None  # primary rays: cull data per shape (PC_COLUMNS)
+    pc32: np.ndarray | None = None  # and what float lanes read of it (P32_COLUMNS, float32)
     behind: np.ndarray | None = None  # a directional light's behind terms (n, 3)
     keys: np.ndarray | None = None  # its stop keys (n, 3), or a point light's behind-test terms (n, SK_COLUMNS)
     unit: np.ndarray | None = None  # a directional light's l / |l|
@@ -47,14 +48,15 @@ def primary(table: np.ndarray, ok: np.ndarray, apex: np.ndarray, dmin: float, dm
     """Per shape, for rays from ``apex`` with directions ``dmin``..``dmax`` long: the world
     radius beyond which no ray line can hit (inf: no bound), a lower bound of the computed
     ``sq_dist`` of any hit (0: none) and the cull data of the kernels' per-packet test
-    (``csrc/kernels.h`` PC_COLUMNS); ``u``, ``tiny`` and ``overflow`` are the precision's
-    unit roundoff, smallest normal and overflow threshold."""
+    (``csrc/kernels.h`` PC_COLUMNS, and P32_COLUMNS for float lanes); ``u``, ``tiny`` and
+    ``overflow`` are the precision's unit roundoff, smallest normal and overflow threshold."""
     n = len(table)
-    radius, floor, pc = arrays((n, np.float64), (n, np.float64), ((n, native.PC_COLUMNS), np.float64))
-    p = shape_pass(table, ok, u, tiny, overflow, native.PASS_PRIMARY, radius=radius, floor=floor, pc=pc)
+    radius, floor, pc, pc32 = arrays((n, np.float64), (n, np.float64), ((n, native.PC_COLUMNS), np.float64),
+                                     ((n, native.P32_COLUMNS), np.float32))
+    p = shape_pass(table, ok, u, tiny, overflow, native.PASS_PRIMARY, radius=radius, floor=floor, pc=pc, pc32=pc32)
     p.block.apex[:] = [float(c) for c in apex]
     p.block.dmin, p.block.dmax = dmin, dmax
-    p.block.floor, p.block.pc = address(p.floor), address(p.pc)
+    p.block.floor, p.block.pc, p.block.pc32 = address(p.floor), address(p.pc), address(p.pc32)
     return p
 
 

@@ -35,7 +35,7 @@ LIGHT_DIRECTIONAL, LIGHT_POINT = 1, 2
 TRACE_SHAPE_VALUES, TRACE_LIGHT_VALUES = 22, 12
 OUT_TESTS, OUT_NAN_TESTS, OUT_SHADOW_RAYS, OUT_HITS, OUT_LO, OUT_HI = 0, 1, 2, 3, 4, 7
 OUT_SHOWN, OUT_NAN_RAYS, OUT_COLUMNS = 10, 11, 12
-PC_COLUMNS = 14
+PC_COLUMNS, P32_COLUMNS = 7, 8  # primary cull data per shape, double and what float lanes read (float)
 BVH_CONE, BVH_FLAT = 0, 1  # a hierarchy's bounds around lines through one apex, or parallel lines
 BUILD_BYTES = 48  # bvh_build's working room a shape
 BV_SINE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 5, 6, 12  # their columns (csrc/kernels.h)
@@ -83,7 +83,7 @@ class Bvh(Structure):
 class Band(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("cam", c_void_p), ("xs", c_void_p), ("ys", c_void_p),
                 ("rotated", c_int32), ("lit", c_int32), ("width", c_int64), ("row0", c_int64), ("row_magic", c_uint64),
-                ("dirs", c_void_p), ("pc", c_void_p), ("floor", c_void_p), ("tree", Bvh),
+                ("dirs", c_void_p), ("pc", c_void_p), ("pc32", c_void_p), ("floor", c_void_p), ("tree", Bvh),
                 ("slot", c_void_p), ("sqd", c_void_p),
                 ("pt", c_void_p), ("nm", c_void_p), ("npix", c_int64), ("bad", c_void_p), ("nan_px", c_void_p),
                 ("acc", c_void_p), ("index", c_void_p), ("background", c_int32), ("rgb", c_void_p),
@@ -127,7 +127,7 @@ class Bundle(Structure):
                 ("apex", c_double * 3), ("dmin", c_double), ("dmax", c_double), ("mid", c_double * 3),
                 ("half", c_double), ("magnitude", c_double), ("chord", c_double), ("l_len", c_double),
                 ("unit", c_void_p), ("u", c_double), ("tiny", c_double), ("overflow", c_double),
-                ("radius", c_void_p), ("floor", c_void_p), ("pc", c_void_p), ("behind", c_void_p),
+                ("radius", c_void_p), ("floor", c_void_p), ("pc", c_void_p), ("pc32", c_void_p), ("behind", c_void_p),
                 ("keys", c_void_p), ("point", c_void_p), ("tree", Bvh), ("items", c_int64), ("box", c_void_p),
                 ("own", c_void_p), ("node_keys", c_void_p), ("jobs", c_int32), ("isa", c_int32), ("chunk", c_int64)]
 

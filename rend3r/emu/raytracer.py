@@ -247,7 +247,8 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
         n = native.library().frame_setup(byref(s), None if first is None else byref(first.block), team)
     tree = bvh.Tree(room.node[:s.nodes], room.items[:s.counts[0]], room.always[:s.counts[1]])
     primary = None if first is None else \
-        (bvh.Bounds(tree, fitted.box[:s.nodes], fitted.frame), first.floor[:n], first.pc[:n])
+        (bvh.Bounds(tree, fitted.box[:s.nodes], fitted.frame), first.floor[:n], first.pc[:n],
+         first.pc32[:n])
     return sf[:n], si[:n], bnd[:n], bounded[:n], out[:n], tree, primary
 
 
@@ -310,11 +311,11 @@ def _bands(fr: _Frame, options: EmuOptions, rows: int) -> tuple[native.Bands, li
         apex = fr.cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)  # at infinity: nothing is bounded
         p = bounds.primary(fr.bnd, fr.bounded, apex, 0.0, 0.0, fr.ar.unit_roundoff, fr.ar.tiny, fr.ar.overflow)
         fitted, own = fr.tree.bounds_for(p.block, apex, None, fr.tree.nodes, False, fr.jobs)
-        primary = (fitted, p.floor, p.pc)
+        primary = (fitted, p.floor, p.pc, p.pc32)
         b.primary = pointer(p.block)
         keep += [p, own]
-    tree, floor, pc = primary
-    band.pc, band.floor, band.tree = address(pc), address(floor), tree.view
+    tree, floor, pc, pc32 = primary
+    band.pc, band.pc32, band.floor, band.tree = address(pc), address(pc32), address(floor), tree.view
     band.index, band.background = address(fr.index), options.background
     keep.append(primary)
     for name in ("directions", "nearest", "light_pass", "shadow_origins"):
@@ -337,8 +338,9 @@ _BAND_COUNTS = ("tests", "skipped", "nan_tests", "nan_rays", "hits", "shadow_ray
 
 
 #: A frame's (or band's) primary bounds: the hierarchy's, and per shape its depth floor
-#: and cull data (set_up, or _bands for a camera whose directions are measured per pixel).
-_Primary = tuple[bvh.Bounds, np.ndarray, np.ndarray]
+#: and cull data, double and float (set_up, or _bands for a camera whose directions are
+#: measured per pixel).
+_Primary = tuple[bvh.Bounds, np.ndarray, np.ndarray, np.ndarray]
 
 
 def _extent(cam: np.ndarray, xs: np.ndarray, ys: np.ndarray, rotated: bool) -> tuple[float, float] | None:

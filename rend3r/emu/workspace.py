@@ -100,21 +100,23 @@ def empty(shape: int | tuple[int, ...], dtype: np.dtype | type = np.float64) -> 
     return np.ndarray(shape, dtype, buf)
 
 
-#: Where each array of :func:`arrays` starts in their buffer: a cache line apart.
+#: Where each array of :func:`arrays` starts: at a cache line of its own.
 _LINE = 64
 
 
 def arrays(*specs: tuple[int | tuple[int, ...], np.dtype | type]) -> tuple[np.ndarray, ...]:
-    """Uninitialized C-contiguous arrays of the (shape, dtype) ``specs``, each starting a
-    cache line apart in one buffer of :func:`empty`: one buffer to find for a frame
-    set-up's dozen arrays. The buffer is held while any of them lives."""
+    """Uninitialized C-contiguous arrays of the (shape, dtype) ``specs``, each starting at
+    a cache line (so that rows of 32 or 64 bytes never straddle two) in one buffer of
+    :func:`empty`: one buffer to find for a frame set-up's dozen arrays. The buffer is
+    held while any of them lives."""
     laid, at = [], 0
     for shape, dtype in specs:
         shape = _shape(shape)
         laid.append((shape, dtype, at))
         at += -(-math.prod(shape) * np.dtype(dtype).itemsize // _LINE) * _LINE
-    buf, view = empty(max(at, 1), np.uint8), np.ndarray
-    return tuple(view(shape, dtype, buf, offset) for shape, dtype, offset in laid)
+    buf, view = empty(max(at, 1) + _LINE, np.uint8), np.ndarray  # the heap aligns to 16 bytes only
+    start = -buf.ctypes.data % _LINE
+    return tuple(view(shape, dtype, buf, start + offset) for shape, dtype, offset in laid)
 
 
 def kept_bytes() -> int:

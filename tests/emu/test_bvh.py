@@ -216,7 +216,7 @@ def fitted(bnd: np.ndarray, ok: np.ndarray, tree: bvh.Tree, jobs: int) -> list:
         p = make()
         b = tree.fit(p, jobs=jobs, **kw)
         box = b.box if "apex" in kw else np.delete(b.box, [4, 5], axis=1)  # a box's columns
-        out += [p.radius, p.floor, p.pc, p.behind, p.keys, box, b.keys, b.item_box]
+        out += [p.radius, p.floor, p.pc, p.pc32, p.behind, p.keys, box, b.keys, b.item_box]
     return out
 
 

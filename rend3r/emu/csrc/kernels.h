@@ -26,12 +26,14 @@ enum { CAM_ORIGIN = 0, CAM_TMIN = 3, CAM_TMAX = 4, CAM_Z = 5, CAM_ROT = 6, CAM_C
 enum { LT_KIND = 0, LT_LOC = 1, LT_DIR = 4, LT_INTENSITY = 7, LT_COLUMNS = 8 };
 enum { LIGHT_DIRECTIONAL = 1, LIGHT_POINT = 2 };
 /* Primary cull data per shape (double): centre minus camera, its squared length, the
- * squared cull radius with slack, the two terms of the behind test (bounds.h), the depth
- * floor rounded down to a float (float lanes compare it with sq_dist), and the float
- * test's terms (cull.h primary_culled8: v rounded to floats, the widened threshold of the
- * line distance, mean2 and the widened behind term; NaN where it must not cull). */
-enum { PC_V = 0, PC_VV = 3, PC_R2 = 4, PC_MEAN2 = 5, PC_BEHIND = 6, PC_FLOOR32 = 7, PC_V32 = 8, PC_T32 = 11,
-       PC_M32 = 12, PC_B32 = 13, PC_COLUMNS = 14 };
+ * squared cull radius with slack and the two terms of the behind test (bounds.h). */
+enum { PC_V = 0, PC_VV = 3, PC_R2 = 4, PC_MEAN2 = 5, PC_BEHIND = 6, PC_COLUMNS = 7 };
+/* What float lanes read of a shape instead (float, 32 bytes a shape: two to a cache line,
+ * so that a pixel pass reads a quarter of the lines the double rows would take): the
+ * depth floor rounded down (compared with sq_dist) and the float test's terms (cull.h
+ * primary_culled8: v rounded to floats, the widened threshold of the line distance, mean2
+ * and the widened behind term; NaN where it must not cull). */
+enum { P32_FLOOR = 0, P32_V = 1, P32_T = 4, P32_M = 5, P32_B = 6, P32_COLUMNS = 8 };
 /* Values per shape and per light in a pixel trace. */
 enum { TRACE_SHAPE_VALUES = 22, TRACE_LIGHT_VALUES = 12 };
 /* What a kernel reports per chunk (double): tests, tests that met NaN or infinity, shadow
@@ -113,6 +115,7 @@ typedef struct {            /* the primary rays of one band of rows */
     uint64_t row_magic;     /* floor(2**40 / width) + 1: band_row without a division */
     void *dirs;             /* pixels x 4: direction and |d|^2, working (rotated camera; else NULL) */
     const double *pc;       /* per shape PC_COLUMNS: the primary rays' cull data (bounds.h) */
+    const float *pc32;      /* per shape P32_COLUMNS: what float lanes read of it */
     const double *floor;    /* depth floor per shape */
     Bvh tree;               /* the shapes, with the primary rays' boxes */
     /* per pixel, for the light passes (lit only; without lights, or with them applied in
@@ -206,6 +209,7 @@ typedef struct {            /* one bundle of rays' bounds (setup.c bundle_bounds
     double u, tiny, overflow;
     double *radius;         /* n: out of the shape pass, else given */
     double *floor, *pc;     /* primary: out, n and n x PC_COLUMNS (floor NULL for shadow rays) */
+    float *pc32;            /* primary: out, n x P32_COLUMNS */
     double *behind, *keys;  /* directional shadow rays: out, n x 3 each (else NULL) */
     double *point;          /* point-light shadow rays: out, n x SK_COLUMNS (else NULL) */
     Bvh tree;               /* node, items, frame, nodes of the tree */

@@ -27,7 +27,7 @@ static int64_t shape_parts(int64_t n, int32_t jobs, int64_t smallest)
 
 #define SHAPE_PASSES(isa) \
     void primary_shapes_##isa(const double *, const uint8_t *, int64_t, const double *, double, double, double, \
-                              double, double, double *, double *, double *); \
+                              double, double, double *, double *, double *, float *); \
     void shadow_shapes_##isa(const double *, const uint8_t *, int64_t, const double *, double, double, double, \
                              double, double, double, double, const double *, double, double *, double *, double *, \
                              double *); \
@@ -52,7 +52,8 @@ static void shape_range(const Bundle *b, int64_t a, int64_t e)
 {
     if (b->pass == PASS_PRIMARY)
         PICK(b, primary_shapes)(b->bnd + B_COLUMNS * a, b->ok + a, e - a, b->apex, b->dmin, b->dmax, b->u, b->tiny,
-                                b->overflow, b->radius + a, b->floor + a, b->pc + PC_COLUMNS * a);
+                                b->overflow, b->radius + a, b->floor + a, b->pc + PC_COLUMNS * a,
+                                b->pc32 + P32_COLUMNS * a);
     else if (b->pass == PASS_SHADOW)
         PICK(b, shadow_shapes)(b->bnd + B_COLUMNS * a, b->ok + a, e - a, b->mid, b->half, b->magnitude, b->dmin,
                                b->chord, b->u, b->tiny, b->overflow, b->unit, b->l_len, b->radius + a,

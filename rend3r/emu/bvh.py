@@ -25,12 +25,14 @@ from .workspace import arrays, empty
 
 @dataclass(frozen=True)
 class Tree:
-    """A built hierarchy: nodes (2 ints each), shape slots leaf by leaf, and the slots every
-    ray tests."""
+    """A built hierarchy: nodes (2 ints each), shape slots leaf by leaf, the slots every ray
+    tests, and per slot its row in a light's bounds (its place in items, or after them in
+    always: ``csrc/kernels.h`` PASS_SHADOW)."""
 
     node: np.ndarray  # (nodes, 2) int32
     items: np.ndarray  # int32
     always: np.ndarray  # int32
+    where: np.ndarray  # int32
 
     @property
     def nodes(self) -> int:
@@ -55,8 +57,9 @@ class Tree:
         native.ptr(radius, np.float64, (n,))
         if floor is not None:
             native.ptr(floor, np.float64, (n,))
-        if keys is not None:  # parallel lines' stop keys, or a point light's behind terms
-            native.ptr(keys, np.float64, (n, 3 if axes is not None else native.SK_COLUMNS))
+        if keys is not None:  # parallel lines' stop keys, or a point light's behind terms; the kernels take them
+            native.ptr(keys, np.float64, (n, 3 if axes is not None else native.SK_COLUMNS))  # in leaf order
+            keys = np.ascontiguousarray(keys[self.items])
         block = native.Bundle()
         block.bnd, block.n, block.radius = address(bnd), n, address(radius)
         block.floor = None if floor is None else address(floor)
@@ -128,8 +131,9 @@ def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
     native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
     ok = np.ascontiguousarray(bounded, np.uint8)  # 0 or 1 (bool or uint8 given)
     native.ptr(ok, np.uint8, (n,))
-    items, always, node = np.empty(n, np.int32), np.empty(n, np.int32), np.empty((max(1, 2 * n), 2), np.int32)
-    counts, room = np.zeros(2, np.int64), empty(n * native.BUILD_BYTES // 8, np.uint64)
-    nodes = native.library().bvh_build(address(bnd), address(ok), n, address(items), address(always), address(node),
-                                       address(counts), address(room), 0)  # new arrays: every entry written
-    return Tree(node[:nodes], items[:counts[0]], always[:counts[1]])
+    items, always, where = np.empty(n, np.int32), np.empty(n, np.int32), np.empty(n, np.int32)
+    node, counts, room = np.empty((max(1, 2 * n), 2), np.int32), np.zeros(2, np.int64), \
+        empty(n * native.BUILD_BYTES // 8, np.uint64)
+    nodes = native.library().bvh_build(address(bnd), address(ok), n, address(items), address(always), address(where),
+                                       address(node), address(counts), address(room), 0)  # new arrays: all written
+    return Tree(node[:nodes], items[:counts[0]], always[:counts[1]], where)

@@ -101,7 +101,7 @@ class Pairs(Structure):
 class LightPass(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("band", POINTER(Band)), ("light", c_void_p), ("scale", c_double * 3),
                 ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
-                ("first", c_int32), ("last", c_int32), ("behind", c_void_p),
+                ("first", c_int32), ("last", c_int32), ("where", c_void_p), ("behind", c_void_p),
                 ("l_hat", c_double * 3), ("l_len", c_double), ("radius", c_void_p), ("tree", Bvh), ("keys", c_void_p),
                 ("point_keys", c_void_p), ("serial", c_int64)]
 
@@ -113,6 +113,7 @@ class Setup(Structure):
                 ("kinds", c_void_p), ("cam", c_void_p), ("tiny", c_double), ("format", POINTER(Format)),
                 ("sf", c_void_p), ("sf_row", c_int64), ("si", c_void_p), ("bnd", c_void_p), ("bounded", c_void_p),
                 ("index_out", c_void_p), ("items", c_void_p), ("always", c_void_p), ("node", c_void_p),
+                ("where", c_void_p),
                 ("room", c_void_p), ("counts", c_int64 * 2), ("nodes", c_int64), ("shapes", c_int64), ("jobs", c_int32),
                 ("chunk", c_int64)]
 
@@ -142,7 +143,7 @@ class Bands(Structure):
     _fields_ = [("band", POINTER(Band)), ("directions", c_void_p), ("nearest", c_void_p), ("light_pass", c_void_p),
                 ("shadow_origins", c_void_p), ("primary", POINTER(Bundle)), ("light_rows", c_void_p),
                 ("light_row", c_int64), ("lights", c_int64), ("light_frames", c_void_p), ("scales", c_void_p),
-                ("fixed", c_int32), ("item", c_int32), ("bounded", c_void_p), ("items", c_int64),
+                ("fixed", c_int32), ("item", c_int32), ("bounded", c_void_p), ("where", c_void_p), ("items", c_int64),
                 ("overflow", c_double), ("jobs", c_int32), ("isa", c_int32), ("chunk", c_int64),
                 ("min_chunk", c_int64), ("chunks_per_job", c_int64), ("counts", c_int64 * BC_COLUMNS),
                 ("memory", c_void_p), ("memory_bytes", c_int64)]
@@ -202,7 +203,8 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
                               c_void_p, c_void_p, c_void_p]),
 }
 _PLAIN = {
-    "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_int32]),
+    "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p,
+                            c_int32]),
     "have_avx2": (c_int32, []),
     "have_avx512": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),

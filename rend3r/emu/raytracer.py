@@ -229,14 +229,15 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
     s = native.Setup(native.kernel_address("shape_tables", ar),
                      native.ptr(values, np.uint16, (rows, PROP_LIMIT)), address(index), rows, address(_SHAPE_PROPS),
                      address(_KINDS), native.ptr(cam, dtype, (native.CAM_COLUMNS,)), ar.tiny, fmt)
-    sf, si, bnd, bounded, out, node, items, always, build = arrays(  # frame_setup fills them; build: its working copies
-        ((rows, native.SF_COLUMNS), dtype), ((rows, native.SI_COLUMNS), np.int64), ((rows, native.B_COLUMNS), np.float64),
-        (rows, np.uint8), (rows, np.int32), ((max(1, 2 * rows), 2), np.int32), (rows, np.int32), (rows, np.int32),
-        (rows * native.BUILD_BYTES // 8, np.uint64))
+    sf, si, bnd, bounded, out, node, items, always, where, build = arrays(  # frame_setup fills them; build: its
+        ((rows, native.SF_COLUMNS), dtype), ((rows, native.SI_COLUMNS), np.int64),  # working copies
+        ((rows, native.B_COLUMNS), np.float64), (rows, np.uint8), (rows, np.int32), ((max(1, 2 * rows), 2), np.int32),
+        (rows, np.int32), (rows, np.int32), (rows, np.int32), (rows * native.BUILD_BYTES // 8, np.uint64))
     s.sf, s.sf_row, s.si, s.bnd, s.bounded, s.index_out = (address(sf), sf.strides[0], address(si), address(bnd),
                                                            address(bounded), address(out))
-    room = bvh.Tree(node, items, always)
-    s.node, s.items, s.always, s.room = address(room.node), address(room.items), address(room.always), address(build)
+    room = bvh.Tree(node, items, always, where)
+    s.node, s.items, s.always, s.where = address(room.node), address(room.items), address(room.always), address(where)
+    s.room = address(build)
     s.jobs, s.chunk = jobs, bounds.SHAPE_CHUNK
     first = None
     if extent is not None:  # the primary bounds in the same call, around the camera origin
@@ -245,7 +246,7 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
         fitted, own = room.bounds_for(first.block, apex, None, room.nodes, False, jobs)  # own: the call's scratch
     with threads.team(jobs) as team:
         n = native.library().frame_setup(byref(s), None if first is None else byref(first.block), team)
-    tree = bvh.Tree(room.node[:s.nodes], room.items[:s.counts[0]], room.always[:s.counts[1]])
+    tree = bvh.Tree(room.node[:s.nodes], room.items[:s.counts[0]], room.always[:s.counts[1]], room.where[:n])
     primary = None if first is None else \
         (bvh.Bounds(tree, fitted.box[:s.nodes], fitted.frame), first.floor[:n], first.pc[:n],
          first.pc32[:n])
@@ -324,6 +325,7 @@ def _bands(fr: _Frame, options: EmuOptions, rows: int) -> tuple[native.Bands, li
     b.light_frames, b.scales = address(fr.light_frames), address(fr.scales)
     b.fixed, b.item, b.bounded, b.items = int(options.intensity_fixed), fr.dtype.itemsize, address(fr.bounded), \
         len(fr.tree.items)
+    b.where = address(fr.tree.where)
     b.overflow, b.jobs, b.isa, b.chunk = fr.ar.overflow, fr.jobs, native.shape_isa(), bounds.SHAPE_CHUNK
     b.min_chunk, b.chunks_per_job = MIN_CHUNK, CHUNKS_PER_JOB
     b.memory_bytes = native.library().band_bytes(byref(b), rows * options.width)

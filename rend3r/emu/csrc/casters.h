@@ -47,13 +47,14 @@ typedef struct {
  * least (shape_bounds.inc shadow_shapes states the test). */
 static inline int shadow_behind(const LightPass *lp, int64_t c, const double *centre, double spread, double least)
 {
-    const double *bh = lp->behind + 3 * c, *bc = lp->sh->bnd + B_COLUMNS * c;
+    int64_t row = lp->where[c];
+    const double *bh = lp->behind + 3 * row, *bc = lp->sh->bnd + B_COLUMNS * c;
     double ahead = least - bh[0];
     if (!(ahead > 0))
         return 0;
     double e0 = bc[B_CENTER] - centre[0], e1 = bc[B_CENTER + 1] - centre[1], e2 = bc[B_CENTER + 2] - centre[2];
     double mid = sqrt(e0 * e0 + e1 * e1 + e2 * e2) * (1.0 + BOUND_SLACK);
-    return mid - spread > lp->radius[c] && lp->l_len * (bh[1] * ahead - bh[2] * (mid + spread)) > 0.015625;
+    return mid - spread > lp->radius[row] && lp->l_len * (bh[1] * ahead - bh[2] * (mid + spread)) > 0.015625;
 }
 
 /* The box (u0, u1, v0, v1) lies farther than reach from (u, v) on one axis. */
@@ -68,7 +69,7 @@ static inline int may_block(const LightPass *lp, int64_t c, const double *centre
 {
     if (shadow_behind(lp, c, centre, spread, least))
         return 0;
-    double r = lp->radius[c];
+    double r = lp->radius[lp->where[c]];
     if (!(r < INFINITY))
         return 1;
     const double *bc = lp->sh->bnd + B_COLUMNS * c;
@@ -89,7 +90,7 @@ static void casters_fill(const LightPass *lp, int64_t s, Casters *e)
     e->count = -1;
     e->centre[0] = bs[B_CENTER]; e->centre[1] = bs[B_CENTER + 1]; e->centre[2] = bs[B_CENTER + 2];
     double mag = fabs(e->centre[0]) + fabs(e->centre[1]) + fabs(e->centre[2]);
-    if (!(rho < INFINITY) || !(mag < INFINITY) || !(lp->radius[s] < INFINITY))
+    if (!(rho < INFINITY) || !(mag < INFINITY) || !(lp->radius[lp->where[s]] < INFINITY))
         return;
     e->inside2 = rho * rho * (1.0 - BOUND_SLACK);  /* a computed squared distance within 4 ulps */
     const double *c = e->centre, *f = t->frame, *l = lp->l_hat;

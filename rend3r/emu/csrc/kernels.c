@@ -162,12 +162,14 @@ static inline void put(int32_t *at, int32_t v, int32_t keep)
  * rounded up to whole leaves.
  * Leaves hold at most BVH_LEAF shapes. items is ordered leaf by leaf; node (2 ints per
  * node, room for 2n nodes) gets the nodes depth first; room (rows x BUILD_BYTES, 8-byte
- * aligned) holds the working copies. With keep (other threads read the tree), items,
- * always and node are written only where they differ: the tree depends on the centres
- * alone, and a frame whose shapes did not move then leaves the last frame's in the other
- * threads' caches (docs/performance-history.md, "Rows left alone"). Returns the node count. */
+ * aligned) holds the working copies; where gets each shape's row in a light's bounds
+ * (kernels.h PASS_SHADOW): its place in items, or count[0] plus its place in always.
+ * With keep (other threads read the tree), items, always, where and node are written
+ * only where they differ: the tree depends on the centres alone, and a frame whose shapes
+ * did not move then leaves the last frame's in the other threads' caches
+ * (docs/performance-history.md, "Rows left alone"). Returns the node count. */
 int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
-                  int32_t *node, int64_t *count_out, void *room, int32_t keep)
+                  int32_t *where, int32_t *node, int64_t *count_out, void *room, int32_t keep)
 {
     int64_t stack[4 * BVH_STACK], top = 1, count = 0, n = 0, outside = 0;
     count_out[0] = count_out[1] = 0;
@@ -188,6 +190,8 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     }
     count_out[0] = n;
     count_out[1] = outside;
+    for (int64_t k = 0; k < outside; k++)
+        put(where + always[k], (int32_t)(n + k), keep);
     if (n == 0)
         return 0;
     double side = MAX(MAX((double)hi3[0] - lo3[0], (double)hi3[1] - lo3[1]), (double)hi3[2] - lo3[2]);
@@ -249,8 +253,10 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
         memcpy(stack + 4 * top++, right, sizeof right);  /* after the left subtree */
         memcpy(stack + 4 * top++, left, sizeof left);    /* the next node */
     }
-    for (int64_t i = 0; i < n; i++)
+    for (int64_t i = 0; i < n; i++) {
         put(items + i, a[i].slot, keep);
+        put(where + a[i].slot, (int32_t)i, keep);
+    }
     return count;
 }
 
@@ -331,19 +337,15 @@ static void cone_union(double *a1, double *cs1, const double *a2_, const double 
 /* A float's unit roundoff, 2**-24. */
 #define U32 5.9604644775390625e-08
 
-/* Refits visit leaves last to first: the floor and keys of the shape of item i - REFIT_AHEAD
- * (width keys a shape) are fetched while item i's are joined (leaf order jumps about the
- * slots, and at tens of thousands of shapes these rows lie in the last-level cache). */
+/* Refits visit leaves last to first: the floor of the shape of item i - REFIT_AHEAD is
+ * fetched while item i's is joined (leaf order jumps about the slots, and at tens of
+ * thousands of shapes these rows lie in the last-level cache). Keys are a light's, in rows
+ * in leaf order (kernels.h PASS_SHADOW). */
 #define REFIT_AHEAD 16
-static inline void fetch_behind(const Bvh *t, int32_t i, const double *floor, const double *keys, int width)
+static inline void fetch_behind(const Bvh *t, int32_t i, const double *floor)
 {
-    if (i < REFIT_AHEAD)
-        return;
-    int64_t s = t->items[i - REFIT_AHEAD];
-    if (floor != NULL)
-        __builtin_prefetch(floor + s);
-    if (keys != NULL)
-        __builtin_prefetch(keys + width * s);
+    if (i >= REFIT_AHEAD && floor != NULL)
+        __builtin_prefetch(floor + t->items[i - REFIT_AHEAD]);
 }
 
 /* bvh_refit for parallel lines: per node the box holding its shapes' boxes, its least
@@ -371,13 +373,12 @@ static void refit_flat(const Bvh *t, const double *floor, double *box, const dou
         }
         for (int32_t i = first; count > 0 && i < first + count; i++) {
             const double *o = items + BX_COLUMNS * (int64_t)i;  /* the shape's own box (flat_items) */
-            int64_t s = t->items[i];
-            fetch_behind(t, i, floor, keys, 3);
-            fl = MIN(fl, floor != NULL ? floor[s] : -INFINITY);
+            fetch_behind(t, i, floor);
+            fl = MIN(fl, floor != NULL ? floor[t->items[i]] : -INFINITY);
             u0 = MIN(u0, o[BV_U0]); u1 = MAX(u1, o[BV_U1]);
             v0 = MIN(v0, o[BV_V0]); v1 = MAX(v1, o[BV_V1]);
             for (int c = 0; keys != NULL && c < 3; c++)
-                k[c] = MAX(k[c], keys[3 * s + c]);
+                k[c] = MAX(k[c], keys[3 * (int64_t)i + c]);
         }
         if (keys != NULL)
             memcpy(node_keys + 3 * at, k, sizeof k);
@@ -433,10 +434,10 @@ static void refit_cones(const Bvh *t, const double *floor, double *box, const do
         }
         for (int32_t i = first; count > 0 && i < first + count; i++) {
             const double *o = items + CI_COLUMNS * (int64_t)i;  /* the shape's own cone (cone_items) */
-            fetch_behind(t, i, floor, keys, SK_COLUMNS);
+            fetch_behind(t, i, floor);
             fl = MIN(fl, floor != NULL ? floor[t->items[i]] : -INFINITY);
             if (keys != NULL)
-                point_join(pk, keys + SK_COLUMNS * (int64_t)t->items[i], 1);
+                point_join(pk, keys + SK_COLUMNS * (int64_t)i, 1);
             if (i == first) {
                 memcpy(b + BV_AXIS, o, 3 * sizeof(double));
                 b[BV_SINE] = o[CI_SINE];
@@ -463,8 +464,9 @@ static void refit_cones(const Bvh *t, const double *floor, double *box, const do
  * bounds (items, in leaf order): for BVH_CONE the double cones around the apex holding the
  * shapes' cones (CI_COLUMNS per item, from cone_items), for parallel lines (BVH_FLAT) the
  * boxes holding the shapes' boxes (BX_COLUMNS per item, from flat_items); and each node's
- * least floor (NULL: -inf); boxes also the stop keys of a directional light's shadow rays
- * (keys NULL: none; refit_flat), cones a point light's behind-test terms (refit_cones).
+ * least floor (NULL: -inf, by slot); boxes also the stop keys of a directional light's
+ * shadow rays (keys NULL: none; refit_flat), cones a point light's behind-test terms
+ * (refit_cones), both in rows in leaf order (kernels.h PASS_SHADOW).
  * Children follow their parent, so nodes go last to
  * first, and lo..hi must hold the subtrees of the nodes it holds (bvh.py refits subtrees
  * on several threads, then the nodes above them); a cone gets the squared sine of its

@@ -147,10 +147,11 @@ typedef struct {            /* one light over one band */
     int32_t parallel;       /* directional light */
     int32_t first;          /* the band's first light: it sets the colour sums instead of adding */
     int32_t last;           /* the band's last light: its pass also finishes the pixels */
-    const double *behind;   /* n x 3 (directional): centre . l/|l|, and the behind test's mean2
+    const int32_t *where;   /* per shape slot, the row of its shadow bounds below (bvh_build) */
+    const double *behind;   /* rows x 3 (directional): centre . l/|l|, and the behind test's mean2
                                and (spread2 + 64 uu smax^2), NaN where no test applies */
     double l_hat[3], l_len; /* a directional light's l/|l| and |l| */
-    const double *radius;   /* cull radius per shape, for these shadow rays */
+    const double *radius;   /* cull radius per row, for these shadow rays */
     Bvh tree;               /* the shapes, with these shadow rays' boxes */
     const double *keys;     /* directional light (else NULL): per node the largest stop keys below it
                                (shape_bounds.inc shadow_shapes, kernels.c bvh_refit) */
@@ -185,6 +186,7 @@ typedef struct {            /* a frame's set-up (setup.c frame_setup) */
     uint8_t *bounded;
     int32_t *index_out;
     int32_t *items, *always, *node; /* out, room for rows, rows and max(1, 2 rows) nodes: the tree */
+    int32_t *where;         /* out, room for rows: per shape its row in a light's bounds (bvh_build) */
     void *room;             /* rows x BUILD_BYTES, 8-byte aligned: the build's working copies */
     int64_t counts[2];      /* out: the tree's items and the shapes outside it */
     int64_t nodes;          /* out: its nodes */
@@ -194,7 +196,11 @@ typedef struct {            /* a frame's set-up (setup.c frame_setup) */
 } Setup;
 
 /* A bundle's shape pass: none (radii given), the primary rays' (shape_bounds.inc
- * primary_shapes) or a light's shadow rays' (shadow_shapes). */
+ * primary_shapes) or a light's shadow rays' (shadow_shapes). A light's per-shape bounds
+ * (radius, behind, keys, point) go in rows in the tree's order: the items' in leaf order,
+ * then the shapes outside the tree (bvh_build's where maps a slot to its row), so that
+ * each subtree's rows are made by the thread that refits the subtree (setup.c
+ * subtree_task); the other passes' rows are by slot. */
 enum { PASS_NONE = 0, PASS_PRIMARY = 1, PASS_SHADOW = 2 };
 
 typedef struct {            /* one bundle of rays' bounds (setup.c bundle_bounds) */
@@ -246,6 +252,7 @@ typedef struct Bands {      /* a frame's bands, each rendered in one call (band.
     int32_t fixed;          /* the device's 13-bit intensity converter */
     int32_t item;           /* bytes of a working value */
     const uint8_t *bounded; /* per shape */
+    const int32_t *where;   /* per shape, its row in a light's bounds (bvh_build) */
     int64_t items;          /* the tree's items */
     double overflow;        /* the precision's overflow threshold */
     int32_t jobs, isa;      /* threads the passes split over; the shape passes' copy (native.py shape_isa) */

@@ -28,11 +28,13 @@ static int64_t shape_parts(int64_t n, int32_t jobs, int64_t smallest)
 #define SHAPE_PASSES(isa) \
     void primary_shapes_##isa(const double *, const uint8_t *, int64_t, const double *, double, double, double, \
                               double, double, double *, double *, double *, float *); \
-    void shadow_shapes_##isa(const double *, const uint8_t *, int64_t, const double *, double, double, double, \
-                             double, double, double, double, const double *, double, double *, double *, double *, \
-                             double *); \
-    void flat_items_##isa(const int32_t *, int64_t, const double *, const double *, const double *, double *); \
-    void cone_items_##isa(const int32_t *, int64_t, const double *, const double *, const double *, double *);
+    void shadow_shapes_##isa(const int32_t *, const double *, const uint8_t *, int64_t, const double *, double, \
+                             double, double, double, double, double, double, const double *, double, double *, \
+                             double *, double *, double *); \
+    void flat_items_##isa(const int32_t *, int64_t, const double *, const double *, int32_t, const double *, \
+                          double *); \
+    void cone_items_##isa(const int32_t *, int64_t, const double *, const double *, int32_t, const double *, \
+                          double *);
 SHAPE_PASSES(base)
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 SHAPE_PASSES(avx2)
@@ -43,22 +45,26 @@ SHAPE_PASSES(avx512)
 #endif
 
 int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
-                  int32_t *node, int64_t *count_out, void *room, int32_t keep);
+                  int32_t *where, int32_t *node, int64_t *count_out, void *room, int32_t keep);
 void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items, const double *keys,
                double *node_keys, int64_t lo, int64_t hi);
 
-/* A bundle's shape pass over shapes a..b. */
+/* The primary rays' shape pass over shapes a..e. */
 static void shape_range(const Bundle *b, int64_t a, int64_t e)
 {
-    if (b->pass == PASS_PRIMARY)
-        PICK(b, primary_shapes)(b->bnd + B_COLUMNS * a, b->ok + a, e - a, b->apex, b->dmin, b->dmax, b->u, b->tiny,
-                                b->overflow, b->radius + a, b->floor + a, b->pc + PC_COLUMNS * a,
-                                b->pc32 + P32_COLUMNS * a);
-    else if (b->pass == PASS_SHADOW)
-        PICK(b, shadow_shapes)(b->bnd + B_COLUMNS * a, b->ok + a, e - a, b->mid, b->half, b->magnitude, b->dmin,
-                               b->chord, b->u, b->tiny, b->overflow, b->unit, b->l_len, b->radius + a,
-                               b->behind != NULL ? b->behind + 3 * a : NULL, b->keys != NULL ? b->keys + 3 * a : NULL,
-                               b->point != NULL ? b->point + SK_COLUMNS * a : NULL);
+    PICK(b, primary_shapes)(b->bnd + B_COLUMNS * a, b->ok + a, e - a, b->apex, b->dmin, b->dmax, b->u, b->tiny,
+                            b->overflow, b->radius + a, b->floor + a, b->pc + PC_COLUMNS * a,
+                            b->pc32 + P32_COLUMNS * a);
+}
+
+/* A light's shape pass over rows a..e of its bounds (kernels.h PASS_SHADOW): the shapes of
+ * slots[0..e - a). */
+static void shadow_rows(const Bundle *b, const int32_t *slots, int64_t a, int64_t e)
+{
+    PICK(b, shadow_shapes)(slots, b->bnd, b->ok, e - a, b->mid, b->half, b->magnitude, b->dmin, b->chord, b->u,
+                           b->tiny, b->overflow, b->unit, b->l_len, b->radius + a,
+                           b->behind != NULL ? b->behind + 3 * a : NULL, b->keys != NULL ? b->keys + 3 * a : NULL,
+                           b->point != NULL ? b->point + SK_COLUMNS * a : NULL);
 }
 
 static void shape_task(void *ctx, int64_t k)
@@ -68,14 +74,17 @@ static void shape_task(void *ctx, int64_t k)
     shape_range(b, edge(b->n, parts, k), edge(b->n, parts, k + 1));
 }
 
-/* Each shape's own cone or box, over the tree's items a..e (leaf order). */
+/* Each shape's own cone or box, over the tree's items a..e (leaf order; a light's radii in
+ * rows, the others' by slot). */
 static void item_range(const Bundle *b, int64_t a, int64_t e)
 {
     const int32_t *items = b->tree.items + a;
+    int32_t by_row = b->pass == PASS_SHADOW;
+    const double *radius = by_row ? b->radius + a : b->radius;
     if (b->kind == BVH_CONE)
-        PICK(b, cone_items)(items, e - a, b->bnd, b->radius, b->tree.frame, b->own + CI_COLUMNS * a);
+        PICK(b, cone_items)(items, e - a, b->bnd, radius, by_row, b->tree.frame, b->own + CI_COLUMNS * a);
     else
-        PICK(b, flat_items)(items, e - a, b->bnd, b->radius, b->tree.frame, b->own + BX_COLUMNS * a);
+        PICK(b, flat_items)(items, e - a, b->bnd, radius, by_row, b->tree.frame, b->own + BX_COLUMNS * a);
 }
 
 /* ---- refits: subtrees side by side, then the nodes above them ---- */
@@ -92,10 +101,14 @@ static void refit_range(const Bundle *b, int64_t lo, int64_t hi)
     bvh_refit(&b->tree, b->floor, b->kind, b->box, b->own, keys, b->node_keys, lo, hi);
 }
 
-/* Subtree k's items, then its refit, so that the thread that makes a subtree's item
- * bounds reads them. Nodes are depth first and leaves hold ranges of items in order: a
- * subtree's items run from its leftmost leaf's first (left children: at + 1) to its
- * rightmost leaf's last (right children: node[at][0]). */
+/* Subtree k's rows of a light's bounds (kernels.h PASS_SHADOW), its items, then its refit,
+ * so that the thread that makes a subtree's rows and item bounds reads them: on two
+ * threads whose cores had separate L3s, a light's shape pass of its own (in even ranges of
+ * slots) took 40-80 us a thread at 4,096 spheres where it takes 20, each of its stores
+ * waiting for the line to be taken from the other core, whose subtree tasks had read it
+ * (docs/performance-history.md). Nodes are depth first and leaves hold ranges of items in
+ * order: a subtree's items run from its leftmost leaf's first (left children: at + 1) to
+ * its rightmost leaf's last (right children: node[at][0]). */
 static void subtree_task(void *ctx, int64_t k)
 {
     const Subtrees *s = ctx;
@@ -105,7 +118,10 @@ static void subtree_task(void *ctx, int64_t k)
         left++;
     while (node[2 * right + 1] == 0)
         right = node[2 * right];
-    item_range(s->b, node[2 * left], (int64_t)node[2 * right] + node[2 * right + 1]);
+    int64_t a = node[2 * left], e = (int64_t)node[2 * right] + node[2 * right + 1];
+    if (s->b->pass == PASS_SHADOW)
+        shadow_rows(s->b, s->b->tree.items + a, a, e);
+    item_range(s->b, a, e);
     refit_range(s->b, lo, s->below[k][1]);
 }
 
@@ -165,12 +181,15 @@ static void bundle_tree(Bundle *b, Team *team)
         refit_range(b, above[i], above[i] + 1);
 }
 
-/* One bundle of rays' bounds: its shape pass (none: radius given), each shape's own cone
- * or box, and the nodes' bounds (bvh.py Tree.refit, bounds.py). */
+/* One bundle of rays' bounds: its shape pass (none: radius given; a light's in its subtree
+ * tasks, and for the shapes outside the tree here), each shape's own cone or box, and the
+ * nodes' bounds (bvh.py Tree.refit, bounds.py). */
 void bundle_bounds(Bundle *b, Team *team)
 {
-    if (b->pass != PASS_NONE)
+    if (b->pass == PASS_PRIMARY)
         team_phase(team, shape_task, b, shape_parts(b->n, b->jobs, b->chunk));
+    else if (b->pass == PASS_SHADOW && b->tree.nalways > 0)
+        shadow_rows(b, b->tree.always, b->items, b->items + b->tree.nalways);
     bundle_tree(b, team);
 }
 
@@ -199,8 +218,8 @@ static void build_task(void *ctx, int64_t k)
     Tables *t = ctx;
     Setup *s = t->s;
     if (k == 0)
-        s->nodes = bvh_build(s->bnd, s->bounded, s->shapes, s->items, s->always, s->node, s->counts, s->room,
-                             s->jobs > 1);
+        s->nodes = bvh_build(s->bnd, s->bounded, s->shapes, s->items, s->always, s->where, s->node, s->counts,
+                             s->room, s->jobs > 1);
     else
         shape_task(t->primary, k - 1);
 }

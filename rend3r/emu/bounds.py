@@ -34,7 +34,7 @@ class Pass:
     block: native.Bundle
     table: np.ndarray  # the bound table (n, B_COLUMNS)
     flags: np.ndarray  # bounded per shape, as uint8
-    radius: np.ndarray  # cull radius per shape
+    radius: np.ndarray  # cull radius per shape (a shadow pass's, like behind and keys, per row: kernels.h PASS_SHADOW)
     floor: np.ndarray | None = None  # primary rays: depth floor per shape
     pc: np.ndarray | None = None  # primary rays: cull data per shape (PC_COLUMNS)
     pc32: np.ndarray | None = None  # and what float lanes read of it (P32_COLUMNS, float32)

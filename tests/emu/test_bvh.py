@@ -274,25 +274,34 @@ def test_light_rows_are_in_leaf_order(n, seed, jobs):
     """A light's per-shape bounds come in rows in the tree's order (csrc/kernels.h
     PASS_SHADOW: the items' in leaf order, then the shapes outside the tree; ``where``
     maps a slot to its row), made in the subtree tasks: put back in slot order, each
-    light's radii and keys refit into the same node bounds, bit for bit."""
+    light's radii and keys refit into the same node bounds, bit for bit; and a shape's rows
+    (radius, behind terms, keys) are its own whatever its slot and row, as the same shapes
+    in another order give them."""
     bnd, _, _ = shapes(n, seed)
-    ok = np.random.default_rng(seed).random(n) < 0.9
-    tree = bvh.build(bnd, ok)
+    rng = np.random.default_rng(seed)
+    ok = rng.random(n) < 0.9
+    order = rng.permutation(n)  # the same shapes in another order: shape s is at slot inverse[s] there
+    inverse = np.argsort(order)
+    tree, other = bvh.build(bnd, ok), bvh.build(bnd[order], ok[order])
     rows = np.concatenate([tree.items, tree.always])
     assert sorted(rows) == list(range(n)) and (tree.where[rows] == np.arange(n)).all()
     lo, hi, limits = bnd[:, :3].min(axis=0), bnd[:, :3].max(axis=0), (2.0**-24, 2.0**-126, 3.4e38)
     axes, apex = np.array([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0]]), np.array([0.5, -1.0, 2.0])
+    lights = (lambda b, o: shadow_pass(b, o, lo, hi, 2.0, *limits, unit=np.array([0, 0, 1.0]), length=2.0),
+              {"axes": axes}), (lambda b, o: shadow_pass(b, o, lo, hi, 0.5, *limits, chord=1e-3), {"apex": apex})
     chunk, bounds.SHAPE_CHUNK = bounds.SHAPE_CHUNK, 8
     try:
-        for make, kw in ((lambda: shadow_pass(bnd, ok, lo, hi, 2.0, *limits, unit=np.array([0, 0, 1.0]), length=2.0),
-                          {"axes": axes}),
-                         (lambda: shadow_pass(bnd, ok, lo, hi, 0.5, *limits, chord=1e-3), {"apex": apex})):
-            p = make()
+        for make, kw in lights:
+            p, q = make(bnd, ok), make(bnd[order], ok[order])
             fit = tree.fit(p, jobs=jobs, **kw)
+            other.fit(q, jobs=jobs, **kw)
             again = tree.refit(bnd, p.radius[tree.where], keys=p.keys[tree.where], jobs=jobs, **kw)
             unused = [4, 5] if "axes" in kw else []  # a box's columns
             assert np.delete(fit.box, unused, axis=1).tobytes() == np.delete(again.box, unused, axis=1).tobytes()
             assert fit.keys.tobytes() == again.keys.tobytes()
+            for mine, theirs in ((p.radius, q.radius), (p.behind, q.behind), (p.keys, q.keys)):
+                if mine is not None:  # by slot: the row of slot s is where[s]
+                    assert _same_bits(mine[tree.where], theirs[other.where][inverse])
     finally:
         bounds.SHAPE_CHUNK = chunk
 

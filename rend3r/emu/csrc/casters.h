@@ -43,11 +43,12 @@ typedef struct {
     double centre[3], inside2;  /* the ball; a point is inside when its squared distance is <= inside2 */
 } Casters;
 
-/* Shape c lies behind every origin within spread of centre whose depth along l is at least
- * least (shape_bounds.inc shadow_shapes states the test). */
-static inline int shadow_behind(const LightPass *lp, int64_t c, const double *centre, double spread, double least)
+/* Shape c (row: its row of the light's bounds, kernels.h PASS_SHADOW) lies behind every
+ * origin within spread of centre whose depth along l is at least least (shape_bounds.inc
+ * shadow_shapes states the test). */
+static inline int shadow_behind(const LightPass *lp, int64_t c, int64_t row, const double *centre, double spread,
+                                double least)
 {
-    int64_t row = lp->where[c];
     const double *bh = lp->behind + 3 * row, *bc = lp->sh->bnd + B_COLUMNS * c;
     double ahead = least - bh[0];
     if (!(ahead > 0))
@@ -63,13 +64,13 @@ static inline int box_beyond(const double *b, double u, double v, double reach)
     return u + reach < b[BV_U0] || u - reach > b[BV_U1] || v + reach < b[BV_V0] || v - reach > b[BV_V1];
 }
 
-/* Shape c (not s) may block a line along l from some point of the ball. */
-static inline int may_block(const LightPass *lp, int64_t c, const double *centre, double spread, double least,
-                            double reach)
+/* Shape c (not s; row: its row) may block a line along l from some point of the ball. */
+static inline int may_block(const LightPass *lp, int64_t c, int64_t row, const double *centre, double spread,
+                            double least, double reach)
 {
-    if (shadow_behind(lp, c, centre, spread, least))
+    if (shadow_behind(lp, c, row, centre, spread, least))
         return 0;
-    double r = lp->radius[lp->where[c]];
+    double r = lp->radius[row];
     if (!(r < INFINITY))
         return 1;
     const double *bc = lp->sh->bnd + B_COLUMNS * c;
@@ -100,7 +101,7 @@ static void casters_fill(const LightPass *lp, int64_t s, Casters *e)
     int32_t n = 0;
     for (int64_t k = 0; k < t->nalways; k++) {
         int64_t a = t->always[k];
-        if (a != s && may_block(lp, a, c, spread, least, reach)) {
+        if (a != s && may_block(lp, a, lp->where[a], c, spread, least, reach)) {
             if (n == CASTER_MAX)
                 return;
             e->item[n++] = (int32_t)a;
@@ -124,7 +125,7 @@ static void casters_fill(const LightPass *lp, int64_t s, Casters *e)
         for (int32_t i = first; i < first + count; i++) {
             int64_t a = t->items[i];
             if (a == s || (t->item_box != NULL && box_beyond(t->item_box + BX_COLUMNS * i, u, v, reach)) ||
-                !may_block(lp, a, c, spread, least, reach))
+                !may_block(lp, a, i, c, spread, least, reach))
                 continue;
             if (n == CASTER_MAX)
                 return;

@@ -213,11 +213,11 @@ typedef struct {            /* one bundle of rays' bounds (setup.c bundle_bounds
     double mid[3], half, magnitude, chord, l_len; /* shadow_shapes' */
     const double *unit;
     double u, tiny, overflow;
-    double *radius;         /* n: out of the shape pass, else given */
+    double *radius;         /* n: out of the shape pass, else given (a light's: rows, PASS_SHADOW) */
     double *floor, *pc;     /* primary: out, n and n x PC_COLUMNS (floor NULL for shadow rays) */
     float *pc32;            /* primary: out, n x P32_COLUMNS */
-    double *behind, *keys;  /* directional shadow rays: out, n x 3 each (else NULL) */
-    double *point;          /* point-light shadow rays: out, n x SK_COLUMNS (else NULL) */
+    double *behind, *keys;  /* directional shadow rays: out, n rows x 3 each (else NULL) */
+    double *point;          /* point-light shadow rays: out, n rows x SK_COLUMNS (else NULL) */
     Bvh tree;               /* node, items, frame, nodes of the tree */
     int64_t items;          /* the tree's items */
     double *box, *own;      /* out: nodes x BV_COLUMNS, items x CI_COLUMNS (cone) or BX_COLUMNS (flat) */

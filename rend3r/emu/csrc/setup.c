@@ -104,7 +104,7 @@ static void refit_range(const Bundle *b, int64_t lo, int64_t hi)
 /* Subtree k's rows of a light's bounds (kernels.h PASS_SHADOW), its items, then its refit,
  * so that the thread that makes a subtree's rows and item bounds reads them: on two
  * threads whose cores had separate L3s, a light's shape pass of its own (in even ranges of
- * slots) took 40-80 us a thread at 4,096 spheres where it takes 20, each of its stores
+ * slots) took 38-95 us a thread at 4,096 spheres where it takes 20, each of its stores
  * waiting for the line to be taken from the other core, whose subtree tasks had read it
  * (docs/performance-history.md). Nodes are depth first and leaves hold ranges of items in
  * order: a subtree's items run from its leftmost leaf's first (left children: at + 1) to

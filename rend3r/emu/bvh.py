@@ -57,9 +57,9 @@ class Tree:
         native.ptr(radius, np.float64, (n,))
         if floor is not None:
             native.ptr(floor, np.float64, (n,))
-        if keys is not None:  # parallel lines' stop keys, or a point light's behind terms; the kernels take them
-            native.ptr(keys, np.float64, (n, 3 if axes is not None else native.SK_COLUMNS))  # in leaf order
-            keys = np.ascontiguousarray(keys[self.items])
+        if keys is not None:  # parallel lines' stop keys, or a point light's behind terms
+            native.ptr(keys, np.float64, (n, 3 if axes is not None else native.SK_COLUMNS))
+            keys = np.ascontiguousarray(keys[self.items])  # the refit reads them in leaf order (a light's rows)
         block = native.Bundle()
         block.bnd, block.n, block.radius = address(bnd), n, address(radius)
         block.floor = None if floor is None else address(floor)

@@ -15,8 +15,10 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.parametrize(("n", "jobs", "smallest", "want"), [
-    (100, 1, 1, 1), (100, 2, 1, 8), (100, 2, 30, 3), (5, 3, 10, 1), (0, 2, 1, 1), (10**6, 3, 10, 12)])
+    (100, 1, 1, 1), (100, 2, 1, 8), (100, 2, 30, 2), (5, 3, 10, 1), (0, 2, 1, 1), (10**6, 3, 10, 12),
+    (20480, 2, 4096, 4), (100, 3, 20, 3), (100, 3, 50, 2)])
 def test_parts_are_a_few_per_thread_and_never_too_short(n, jobs, smallest, want):
+    """Up to four a thread, a multiple of the threads when there are at least as many."""
     assert threads.parts(n, jobs, smallest) == want
 
 

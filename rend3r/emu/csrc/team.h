@@ -71,13 +71,20 @@ void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks);
 #define MAX_PARTS 256
 
 /* How many ranges 0..n splits into on jobs threads: up to per_job a thread, so that uneven
- * work evens out, none shorter than smallest unless there is only one. */
+ * work evens out, none shorter than smallest unless there is only one, and a multiple of
+ * jobs when there are at least jobs. Even ranges then split evenly (the leader takes
+ * from the front, the members from the back), and passes over the same rows split them
+ * at the same places, so each thread's rows stay in its cache from pass to pass: the
+ * pairs' passes at 4,096 spheres split into 5 ranges, the leader wrote 3 of them, and
+ * on two threads whose cores had separate L3s its writes took twice the member's
+ * (docs/performance-history.md). */
 static inline int64_t parts_of(int64_t n, int32_t jobs, int64_t smallest, int64_t per_job)
 {
     if (jobs <= 1 || n <= 0)
         return 1;
     int64_t parts = n / (smallest > 0 ? smallest : 1), most = per_job * (int64_t)jobs;
     parts = parts < most ? parts : most;
+    parts -= parts >= jobs ? parts % jobs : 0;
     return parts < 1 ? 1 : parts;
 }
 

@@ -119,7 +119,7 @@ class Bounds:
     def _view(self) -> native.Bvh:
         """The kernels' view (the arrays must outlive it)."""
         t = self.tree
-        return native.Bvh(address(t.node), address(t.items), address(self.box), (*self.frame,), t.nodes,
+        return native.Bvh(address(t.node), address(t.items), address(self.box), tuple(self.frame.tolist()), t.nodes,
                           address(t.always), len(t.always),
                           None if self.item_box is None else address(self.item_box))
 

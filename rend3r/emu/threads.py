@@ -37,7 +37,7 @@ def parts(n: int, jobs: int, smallest: int) -> int:
     n * (k + 1) // parts: csrc/team.h parts_of and edge, which says why)."""
     if jobs <= 1:
         return 1
-    count = min(4 * jobs, n // smallest)
+    count = min(4 * jobs, n // max(1, smallest))
     return max(1, count - count % jobs if count >= jobs else count)
 
 

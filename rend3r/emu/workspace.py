@@ -108,10 +108,10 @@ _LINE = 64
 
 
 def arrays(*specs: tuple[int | tuple[int, ...], np.dtype | type]) -> tuple[np.ndarray, ...]:
-    """Uninitialized C-contiguous arrays of the (shape, dtype) ``specs``, each starting at
-    a cache line (so that rows of 32 or 64 bytes never straddle two) in one buffer of
-    :func:`empty`: one buffer to find for a frame set-up's dozen arrays. The buffer is
-    held while any of them lives."""
+    """Uninitialized C-contiguous arrays of the (shape, dtype) ``specs`` (shapes as ints or
+    tuples: the layouts are kept by them), each starting at a cache line (so that rows of
+    32 or 64 bytes never straddle two) in one buffer of :func:`empty`: one buffer to find
+    for a frame set-up's dozen arrays. The buffer is held while any of them lives."""
     size, laid = _layout(specs)
     buf, view = empty(size + _LINE, np.uint8), np.ndarray  # the heap aligns to 16 bytes only
     start = -address(buf) % _LINE
@@ -122,7 +122,7 @@ def arrays(*specs: tuple[int | tuple[int, ...], np.dtype | type]) -> tuple[np.nd
 def _layout(specs: tuple[tuple[int | tuple[int, ...], np.dtype | type], ...]) -> tuple[int, tuple]:
     """The bytes :func:`arrays` lays ``specs`` out in, and each array's (shape, dtype,
     offset); kept, as a frame's set-up asks for the same few layouts frame after frame
-    (working them out again took half of its calls' 12 us)."""
+    (working them out again took 7 of a ten-array call's 12 us, warm)."""
     laid, at = [], 0
     for shape, dtype in specs:
         shape = _shape(shape)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rend3r.emu import threads
+from rend3r.emu import native, threads
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -20,6 +20,16 @@ ROOT = Path(__file__).resolve().parents[2]
 def test_parts_are_a_few_per_thread_and_never_too_short(n, jobs, smallest, want):
     """Up to four a thread, a multiple of the threads when there are at least as many."""
     assert threads.parts(n, jobs, smallest) == want
+
+
+def test_parts_split_as_the_compiled_passes_do():
+    """threads.parts (the pairs' passes) and csrc/team.h parts_of (every compiled pass)
+    split alike, so that passes over the same rows split them at the same places."""
+    lib = native.library()
+    for jobs in range(0, 10):
+        for smallest in (1, 2, 3, 7, 40, 4096):
+            for n in (0, 1, 5, 17, 64, 100, 599, 20480, 10**6):
+                assert threads.parts(n, jobs, smallest) == lib.team_parts(n, jobs, smallest, 4), (n, jobs, smallest)
 
 
 def test_a_team_is_led_once_per_thread_and_ends_with_its_block():

@@ -20,7 +20,7 @@
 static int64_t shape_parts(int64_t n, int32_t jobs, int64_t smallest)
 {
     int64_t parts = parts_of(n, jobs, smallest, SHAPE_PARTS_PER_JOB);
-    return parts < MAX_PARTS ? parts : MAX_PARTS;
+    return parts <= MAX_PARTS ? parts : MAX_PARTS - (jobs <= MAX_PARTS ? MAX_PARTS % jobs : 0);  /* still a multiple */
 }
 
 /* ---- per-shape passes (kernels.c, shape_bounds.inc) ---- */

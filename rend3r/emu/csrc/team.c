@@ -357,6 +357,13 @@ Team *team_open_backwards(void)
     return t;
 }
 
+/* The split the passes take (team.h parts_of), for the check that threads.py parts takes
+ * the same (tests/emu/test_threads.py). */
+int64_t team_parts(int64_t n, int32_t jobs, int64_t smallest, int64_t per_job)
+{
+    return parts_of(n, jobs, smallest, per_job);
+}
+
 /* A check of the protocol (tests/emu/test_threads.py). */
 
 static _Thread_local char team_here;  /* its address tells the threads apart */

@@ -72,12 +72,14 @@ void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks);
 
 /* How many ranges 0..n splits into on jobs threads: up to per_job a thread, so that uneven
  * work evens out, none shorter than smallest unless there is only one, and a multiple of
- * jobs when there are at least jobs. Even ranges then split evenly (the leader takes
- * from the front, the members from the back), and passes over the same rows split them
- * at the same places, so each thread's rows stay in its cache from pass to pass: the
- * pairs' passes at 4,096 spheres split into 5 ranges, the leader wrote 3 of them, and
- * on two threads whose cores had separate L3s its writes took twice the member's
- * (docs/performance-history.md). */
+ * jobs when there are at least jobs. Equal ranges then split evenly between the threads
+ * when each takes its share (the leader from the front, the members from the back), and
+ * passes over the same rows split them at the same places, so a thread that takes the
+ * same ranges from pass to pass finds its rows in its own cache: the pairs' passes at
+ * 4,096 spheres split into 5 ranges, the leader wrote 3 of them, rows the member read
+ * in the shape tables' 4, and on two threads whose cores had separate L3s its writes
+ * took twice the member's (docs/performance-history.md, "Ranges a multiple of the
+ * thread count"). */
 static inline int64_t parts_of(int64_t n, int32_t jobs, int64_t smallest, int64_t per_job)
 {
     if (jobs <= 1 || n <= 0)

@@ -121,7 +121,7 @@ class Bounds:
         t = self.tree
         return native.Bvh(address(t.node), address(t.items), address(self.box), tuple(self.frame.tolist()), t.nodes,
                           address(t.always), len(t.always),
-                          None if self.item_box is None else address(self.item_box))
+                          None if self.item_box is None else address(self.item_box), address(t.where))
 
 
 def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:

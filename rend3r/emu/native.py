@@ -77,7 +77,8 @@ class Shapes(Structure):
 
 class Bvh(Structure):
     _fields_ = [("node", c_void_p), ("items", c_void_p), ("box", c_void_p), ("frame", c_double * 6),
-                ("nodes", c_int64), ("always", c_void_p), ("nalways", c_int64), ("item_box", c_void_p)]
+                ("nodes", c_int64), ("always", c_void_p), ("nalways", c_int64), ("item_box", c_void_p),
+                ("where", c_void_p)]
 
 
 class Band(Structure):
@@ -101,7 +102,7 @@ class Pairs(Structure):
 class LightPass(Structure):
     _fields_ = [("sh", POINTER(Shapes)), ("band", POINTER(Band)), ("light", c_void_p), ("scale", c_double * 3),
                 ("fixed", c_int32), ("shadows", c_int32), ("parallel", c_int32),
-                ("first", c_int32), ("last", c_int32), ("where", c_void_p), ("behind", c_void_p),
+                ("first", c_int32), ("last", c_int32), ("behind", c_void_p),
                 ("l_hat", c_double * 3), ("l_len", c_double), ("radius", c_void_p), ("tree", Bvh), ("keys", c_void_p),
                 ("point_keys", c_void_p), ("serial", c_int64)]
 
@@ -143,7 +144,7 @@ class Bands(Structure):
     _fields_ = [("band", POINTER(Band)), ("directions", c_void_p), ("nearest", c_void_p), ("light_pass", c_void_p),
                 ("shadow_origins", c_void_p), ("primary", POINTER(Bundle)), ("light_rows", c_void_p),
                 ("light_row", c_int64), ("lights", c_int64), ("light_frames", c_void_p), ("scales", c_void_p),
-                ("fixed", c_int32), ("item", c_int32), ("bounded", c_void_p), ("where", c_void_p), ("items", c_int64),
+                ("fixed", c_int32), ("item", c_int32), ("bounded", c_void_p), ("items", c_int64),
                 ("overflow", c_double), ("jobs", c_int32), ("isa", c_int32), ("chunk", c_int64),
                 ("min_chunk", c_int64), ("chunks_per_job", c_int64), ("counts", c_int64 * BC_COLUMNS),
                 ("memory", c_void_p), ("memory_bytes", c_int64)]

@@ -325,7 +325,6 @@ def _bands(fr: _Frame, options: EmuOptions, rows: int) -> tuple[native.Bands, li
     b.light_frames, b.scales = address(fr.light_frames), address(fr.scales)
     b.fixed, b.item, b.bounded, b.items = int(options.intensity_fixed), fr.dtype.itemsize, address(fr.bounded), \
         len(fr.tree.items)
-    b.where = address(fr.tree.where)
     b.overflow, b.jobs, b.isa, b.chunk = fr.ar.overflow, fr.jobs, native.shape_isa(), bounds.SHAPE_CHUNK
     b.min_chunk, b.chunks_per_job = MIN_CHUNK, CHUNKS_PER_JOB
     b.memory_bytes = native.library().band_bytes(byref(b), rows * options.width)

@@ -292,7 +292,7 @@ static void light(Bands *f, Team *team, Work *w, int64_t k, const double *hits, 
     int64_t n = b->sh->n;
     LightPass lp = {.sh = b->sh, .band = b, .light = f->light_rows + f->light_row * k, .fixed = f->fixed,
                     .shadows = n > 1, .parallel = lf[LF_PARALLEL] != 0, .first = k == 0, .last = k == f->lights - 1,
-                    .where = f->where, .serial = next_serial()};
+                    .serial = next_serial()};
     memcpy(lp.scale, f->scales + 3 * k, sizeof lp.scale);
     if (lp.shadows)
         shadow_bounds(f, team, w, &lp, lf, hits);

@@ -91,7 +91,7 @@ static void casters_fill(const LightPass *lp, int64_t s, Casters *e)
     e->count = -1;
     e->centre[0] = bs[B_CENTER]; e->centre[1] = bs[B_CENTER + 1]; e->centre[2] = bs[B_CENTER + 2];
     double mag = fabs(e->centre[0]) + fabs(e->centre[1]) + fabs(e->centre[2]);
-    if (!(rho < INFINITY) || !(mag < INFINITY) || !(lp->radius[lp->where[s]] < INFINITY))
+    if (!(rho < INFINITY) || !(mag < INFINITY) || !(lp->radius[lp->tree.where[s]] < INFINITY))
         return;
     e->inside2 = rho * rho * (1.0 - BOUND_SLACK);  /* a computed squared distance within 4 ulps */
     const double *c = e->centre, *f = t->frame, *l = lp->l_hat;
@@ -101,7 +101,7 @@ static void casters_fill(const LightPass *lp, int64_t s, Casters *e)
     int32_t n = 0;
     for (int64_t k = 0; k < t->nalways; k++) {
         int64_t a = t->always[k];
-        if (a != s && may_block(lp, a, lp->where[a], c, spread, least, reach)) {
+        if (a != s && may_block(lp, a, lp->tree.where[a], c, spread, least, reach)) {
             if (n == CASTER_MAX)
                 return;
             e->item[n++] = (int32_t)a;

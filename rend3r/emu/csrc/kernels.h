@@ -102,6 +102,7 @@ typedef struct {
     const int32_t *always;  /* shape slots outside the tree (no finite bound): every ray tests them */
     int64_t nalways;
     const double *item_box; /* parallel lines: items x BX_COLUMNS, each shape's own box (else NULL) */
+    const int32_t *where;   /* per shape slot, its row in a light's bounds (bvh_build; PASS_SHADOW) */
 } Bvh;
 
 typedef struct {            /* the primary rays of one band of rows */
@@ -147,7 +148,6 @@ typedef struct {            /* one light over one band */
     int32_t parallel;       /* directional light */
     int32_t first;          /* the band's first light: it sets the colour sums instead of adding */
     int32_t last;           /* the band's last light: its pass also finishes the pixels */
-    const int32_t *where;   /* per shape slot, the row of its shadow bounds below (bvh_build) */
     const double *behind;   /* rows x 3 (directional): centre . l/|l|, and the behind test's mean2
                                and (spread2 + 64 uu smax^2), NaN where no test applies */
     double l_hat[3], l_len; /* a directional light's l/|l| and |l| */
@@ -252,7 +252,6 @@ typedef struct Bands {      /* a frame's bands, each rendered in one call (band.
     int32_t fixed;          /* the device's 13-bit intensity converter */
     int32_t item;           /* bytes of a working value */
     const uint8_t *bounded; /* per shape */
-    const int32_t *where;   /* per shape, its row in a light's bounds (bvh_build) */
     int64_t items;          /* the tree's items */
     double overflow;        /* the precision's overflow threshold */
     int32_t jobs, isa;      /* threads the passes split over; the shape passes' copy (native.py shape_isa) */

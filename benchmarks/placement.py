@@ -17,8 +17,10 @@ processes (two_cpus.py) mostly do not:
 (Medians over 8,393 rounds of three frames each way at 4,096 spheres, fp32, 2026-12-04;
 docs/performance-history.md.) The kinds are told apart by the ratio of the two reads, so that
 they do not depend on this machine's clock; the cuts between them are set from this
-EPYC's figures (ratios of about 1-1.8, 2.4-5.3 and 9.6-23), and another design (a mesh
-of cores sharing one L3, say) may need others.
+EPYC's figures (ratios of about 1-1.8, 2.4-5.3 and 9.6-23), so they name L3s on AMD
+processors only. Elsewhere a slow read does not tell the L3s apart: on a Xeon's mesh,
+whose cores share one L3 in slices, a line crosses in some 70 ns (a ratio of about 20,
+2026-12-05), as between the EPYC's L3s. There the second kind is ``two cores``.
 
     python benchmarks/placement.py [--measures 10]
 """
@@ -41,23 +43,44 @@ from pathlib import Path
 SOURCE = Path(__file__).with_suffix(".c")
 #: Cross-CPU read time over the writer's own read time: below ONE_CORE the CPUs share an L2,
 #: below SHARED_L3 an L3, else neither (each cut near the geometric middle of the ranges
-#: measured on either side of it here).
+#: measured on either side of it here, on an AMD EPYC: the vendor CALIBRATED names).
 ONE_CORE, SHARED_L3 = 2.0, 7.0
-KINDS = ("one core", "shared L3", "separate L3s")
+CALIBRATED = "AuthenticAMD"
+KINDS = ("one core", "shared L3", "separate L3s", "two cores")
 
 
 @dataclass(frozen=True)
 class Placement:
     """One measure: ns per line read on the other CPU and on the writer's own, and what
-    their ratio says."""
+    their ratio says (about L3s only on a processor of the CALIBRATED vendor)."""
 
     cross_ns: float
     own_ns: float
+    calibrated: bool = True
 
     @property
     def kind(self) -> str:
         ratio = self.cross_ns / self.own_ns
-        return KINDS[0] if ratio < ONE_CORE else KINDS[1] if ratio < SHARED_L3 else KINDS[2]
+        if ratio < ONE_CORE:
+            return KINDS[0]
+        if not self.calibrated:
+            return KINDS[3]
+        return KINDS[1] if ratio < SHARED_L3 else KINDS[2]
+
+
+@lru_cache(maxsize=1)
+def vendor() -> str:
+    """This processor's vendor as Linux names it (``AuthenticAMD``, ``GenuineIntel``), or
+    an empty string where /proc/cpuinfo does not say."""
+    try:
+        with open("/proc/cpuinfo", encoding="ascii", errors="replace") as f:
+            for line in f:
+                key, _, value = line.partition(":")
+                if key.strip() == "vendor_id":
+                    return value.strip()
+    except OSError:
+        pass
+    return ""
 
 
 @lru_cache(maxsize=1)
@@ -111,7 +134,7 @@ def measure(cpus: set[int], rounds: int = 5) -> Placement:
             raise RuntimeError(f"placement not measured: CPUs {src} and {dst} could not be used")
         cross.append(out[0])
         own.append(out[1])
-    return Placement(sum(cross) / 2, sum(own) / 2)
+    return Placement(sum(cross) / 2, sum(own) / 2, vendor() == CALIBRATED)
 
 
 def main() -> int:

@@ -23,11 +23,18 @@ def test_the_kind_follows_the_ratio_of_the_reads(cross, own, kind):
     assert placement.Placement(cross, own).kind == kind
 
 
+@pytest.mark.parametrize(("cross", "own", "kind"), [
+    (7.9, 4.0, "one core"), (8.0, 4.0, "two cores"), (70.0, 3.5, "two cores")])
+def test_a_design_the_cuts_were_not_set_for_names_no_l3(cross, own, kind):
+    assert placement.Placement(cross, own, calibrated=False).kind == kind
+
+
 @pytest.mark.skipif(WHY is not None, reason=f"placement not measured: {WHY}")
 def test_two_cpus_are_measured_and_placed():
     p = placement.measure(os.sched_getaffinity(0), rounds=3)
     assert all(math.isfinite(x) and 0 < x < 10_000 for x in (p.cross_ns, p.own_ns))
     assert p.kind in placement.KINDS
+    assert p.calibrated == (placement.vendor() == placement.CALIBRATED)
 
 
 @pytest.mark.skipif(WHY is not None, reason=f"placement not measured: {WHY}")

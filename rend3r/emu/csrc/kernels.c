@@ -19,7 +19,6 @@
 
 #include "bounds.h"
 #include "bvh.h"
-#include "colour.h"
 #include "fround.h"
 #include "kernels.h"
 #include "simd.h"

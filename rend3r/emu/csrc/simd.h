@@ -1,4 +1,5 @@
-/* SIMD packets: GCC/Clang vector extensions, 32 bytes wide (8 floats or 4 doubles).
+/* SIMD packets: GCC/Clang vector extensions, 32 bytes wide (8 floats or 4 doubles; a float
+ * packet's colours in double, 64 bytes).
  *
  * Without AVX the compiler splits each operation into two SSE (or NEON) operations; the
  * kernels are also built for AVX2 and chosen at load time. Lane operations are IEEE
@@ -20,6 +21,8 @@ typedef float f32x8 __attribute__((vector_size(32)));
 typedef uint32_t u32x8 __attribute__((vector_size(32)));
 typedef int32_t i32x8 __attribute__((vector_size(32)));
 typedef double f64x4 __attribute__((vector_size(32)));
+typedef double f64x8 __attribute__((vector_size(64)));
+typedef int64_t i64x8 __attribute__((vector_size(64)));
 typedef uint64_t u64x4 __attribute__((vector_size(32)));
 typedef int64_t i64x4 __attribute__((vector_size(32)));
 typedef int32_t i32x4 __attribute__((vector_size(16)));
@@ -77,33 +80,6 @@ INLINE f32x8 cross2_8(float a0, float a1, float a2, f32x8 w0, f32x8 w1, f32x8 w2
 {
     f32x8 c0 = w1 * a2 - w2 * a1, c1 = w2 * a0 - w0 * a2, c2 = w0 * a1 - w1 * a0;
     return c0 * c0 + c1 * c1 + c2 * c2;
-}
-
-/* n consecutive doubles (n <= 4; the last repeated past n), and back. */
-INLINE f64x4 load4(const double *a, int n)
-{
-    f64x4 v;
-    if (n == 4) {
-        memcpy(&v, a, sizeof v);
-        return v;
-    }
-    for (int i = 0; i < 4; i++)
-        v[i] = a[i < n ? i : n - 1];
-    return v;
-}
-
-INLINE void store4(double *a, f64x4 v, int n)
-{
-    if (n == 4) {
-        memcpy(a, &v, sizeof v);
-        return;
-    }
-    if (n > 0)  /* lane by lane: a loop here becomes a call to memcpy */
-        a[0] = v[0];
-    if (n > 1)
-        a[1] = v[1];
-    if (n > 2)
-        a[2] = v[2];
 }
 
 /* Flags (bytes that are 0 or 1) as the bits of an int, byte i giving bit i: one

@@ -1,9 +1,10 @@
 /* Where the host put two CPUs of this machine, seen from inside: the time of a dependent
  * read, on one CPU, of cache lines the other has just written (placement.py compiles and
  * loads this file). On a VM the host may run the two vCPUs on one core's two hardware
- * threads (a shared L2: a few ns a line), on two cores sharing an L3 (some 20 ns here),
- * or on cores with separate L3s (some 85 ns here), and moves them between these every few
- * seconds to minutes. */
+ * threads (a shared L2: a few ns a line), on two cores sharing an L3 (some 20 ns on the
+ * AMD EPYC host this project's VM first ran on; some 70 ns on an Intel Xeon's mesh), or on
+ * cores with separate L3s (some 85 ns on that EPYC), and may move them between these every
+ * few seconds to minutes. */
 #define _GNU_SOURCE
 #include <pthread.h>
 #include <sched.h>

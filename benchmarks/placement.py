@@ -2,9 +2,9 @@
 long a dependent read on one CPU takes for cache lines the other has just written, against
 the same read on the writer itself.
 
-On this project's VM (2 vCPUs of an AMD EPYC) the host moves the two vCPUs every few
-seconds to minutes between three placements, which a split frame feels and two pinned
-processes (two_cpus.py) mostly do not:
+On the host of AMD EPYCs this project's VM first ran on, the host moved the two vCPUs
+every few seconds to minutes between three placements, which a split frame feels and two
+pinned processes (two_cpus.py) mostly do not:
 
 - ``one core``: the two hardware threads of one core (a shared L2: the other CPU's lines
   read about as fast as its own). Both CPUs then run slower; ``--jobs 2`` measured 1.12x.
@@ -16,11 +16,13 @@ processes (two_cpus.py) mostly do not:
 
 (Medians over 8,393 rounds of three frames each way at 4,096 spheres, fp32, 2026-12-04;
 docs/performance-history.md.) The kinds are told apart by the ratio of the two reads, so that
-they do not depend on this machine's clock; the cuts between them are set from this
+they do not depend on this machine's clock; the cuts between them are set from that
 EPYC's figures (ratios of about 1-1.8, 2.4-5.3 and 9.6-23), so they name L3s on AMD
-processors only. Elsewhere a slow read does not tell the L3s apart: on a Xeon's mesh,
-whose cores share one L3 in slices, a line crosses in some 70 ns (a ratio of about 20,
-2026-12-05), as between the EPYC's L3s. There the second kind is ``two cores``.
+processors only. Elsewhere a slow read does not tell the L3s apart: on the Xeon host the
+VM moved to (2026-12-05), whose cores share one L3 in slices on a mesh, a line crossed in
+some 70 ns (a ratio of about 20), as between the EPYC's L3s. There the kind above
+``one core`` is ``two cores``, which says nothing of the L3s (nor whether the two cores
+are on one socket); the ``one core`` cut is the EPYC's on every processor.
 
     python benchmarks/placement.py [--measures 10]
 """
@@ -36,6 +38,7 @@ import sys
 import sysconfig
 import tempfile
 import time
+from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -56,7 +59,7 @@ class Placement:
 
     cross_ns: float
     own_ns: float
-    calibrated: bool = True
+    calibrated: bool  # on a processor of the CALIBRATED vendor
 
     @property
     def kind(self) -> str:
@@ -74,12 +77,17 @@ def vendor() -> str:
     an empty string where /proc/cpuinfo does not say."""
     try:
         with open("/proc/cpuinfo", encoding="ascii", errors="replace") as f:
-            for line in f:
-                key, _, value = line.partition(":")
-                if key.strip() == "vendor_id":
-                    return value.strip()
+            return vendor_of(f)
     except OSError:
-        pass
+        return ""
+
+
+def vendor_of(cpuinfo: Iterable[str]) -> str:
+    """The first ``vendor_id`` of /proc/cpuinfo's lines, or an empty string."""
+    for line in cpuinfo:
+        key, _, value = line.partition(":")
+        if key.strip() == "vendor_id":
+            return value.strip()
     return ""
 
 

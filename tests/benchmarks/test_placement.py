@@ -20,7 +20,7 @@ WHY = placement.available()
     (4.2, 4.1, "one core"), (7.9, 4.0, "one core"), (8.0, 4.0, "shared L3"), (19.0, 5.0, "shared L3"),
     (27.9, 4.0, "shared L3"), (28.0, 4.0, "separate L3s"), (85.0, 5.0, "separate L3s")])
 def test_the_kind_follows_the_ratio_of_the_reads(cross, own, kind):
-    assert placement.Placement(cross, own).kind == kind
+    assert placement.Placement(cross, own, calibrated=True).kind == kind
 
 
 @pytest.mark.parametrize(("cross", "own", "kind"), [
@@ -34,7 +34,14 @@ def test_two_cpus_are_measured_and_placed():
     p = placement.measure(os.sched_getaffinity(0), rounds=3)
     assert all(math.isfinite(x) and 0 < x < 10_000 for x in (p.cross_ns, p.own_ns))
     assert p.kind in placement.KINDS
-    assert p.calibrated == (placement.vendor() == placement.CALIBRATED)
+    assert p.calibrated == (placement.vendor() == "AuthenticAMD")
+
+
+@pytest.mark.parametrize(("lines", "vendor"), [
+    (["processor\t: 0\n", "vendor_id\t: AuthenticAMD\n", "vendor_id\t: GenuineIntel\n"], "AuthenticAMD"),
+    (["vendor_id : GenuineIntel\n"], "GenuineIntel"), (["processor\t: 0\n", "model name\t: vendor_id\n"], ""), ([], "")])
+def test_the_vendor_is_the_first_vendor_id_line(lines, vendor):
+    assert placement.vendor_of(lines) == vendor
 
 
 @pytest.mark.skipif(WHY is not None, reason=f"placement not measured: {WHY}")

@@ -5,7 +5,8 @@
  * includer (instances.inc) names the packet's vectors: CV its lanes in double, CM their
  * masks, CI and CU its 32-bit integers, signed and not (eight doubles make one AVX-512
  * register, where a float packet's colours took two four-lane halves before). Lanes are
- * independent (a pixel trace reads lane 0). */
+ * independent (a pixel trace reads lane 0). A translation unit builds one precision, so
+ * the guard lets these types be the includer's. */
 #ifndef REND3R_COLOUR_H
 #define REND3R_COLOUR_H
 
@@ -75,7 +76,12 @@ INLINE CV load_colours(const double *a, int n)
 
 INLINE void store_colours(double *a, CV v, int n)
 {
-    memcpy(a, &v, (size_t)n * sizeof(double));
+    if (n == LANES) {
+        memcpy(a, &v, sizeof v);
+        return;
+    }
+    for (int i = 0; i < n; i++)  /* a packet's last pixels of a row: rare */
+        a[i] = v[i];
 }
 
 #endif

@@ -1,7 +1,7 @@
 /* SIMD packets: GCC/Clang vector extensions, 32 bytes wide (8 floats or 4 doubles; a float
  * packet's colours in double, 64 bytes).
  *
- * Without AVX the compiler splits each operation into two SSE (or NEON) operations; the
+ * Without AVX the compiler splits each operation into SSE (or NEON) operations; the
  * kernels are also built for AVX2 and chosen at load time. Lane operations are IEEE
  * operations of the element type, so a lane computes exactly what a scalar would.
  * Comparisons give masks (all ones or zero per lane) of the same-width signed integers.

@@ -220,7 +220,7 @@ _PLAIN = {
     "team_close": (None, [c_void_p]),
     "team_check_runs": (None, [c_void_p, c_void_p, c_int64, c_void_p]),  # tests only (team.c)
     "team_open_backwards": (c_void_p, []),  # tests only (team.c)
-    "team_parts": (c_int64, [c_int64, c_int32, c_int64, c_int64]),  # tests only (team.c)
+    "team_parts": (c_int64, [c_int64, c_int32, c_int64, c_int64]),  # threads.parts
     "frame_setup": (c_int64, [POINTER(Setup), POINTER(Bundle), c_void_p]),
     "bundle_bounds": (None, [POINTER(Bundle), c_void_p]),
     "band_bytes": (c_int64, [POINTER(Bands), c_int64]),

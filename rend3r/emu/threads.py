@@ -31,14 +31,11 @@ def available_cores() -> int:
 
 
 def parts(n: int, jobs: int, smallest: int) -> int:
-    """How many ranges 0..n splits into on ``jobs`` threads: up to four a thread (so that
-    uneven work evens out), none shorter than ``smallest`` unless there is only one, a
-    multiple of ``jobs`` when there are at least ``jobs`` (range k is n * k // parts ..
-    n * (k + 1) // parts: csrc/team.h parts_of and edge, which says why)."""
-    if jobs <= 1:
-        return 1
-    count = min(4 * jobs, n // max(1, smallest))
-    return max(1, count - count % jobs if count >= jobs else count)
+    """How many ranges 0..n splits into on ``jobs`` threads, as every compiled pass splits
+    (csrc/team.h parts_of, which says why, with up to four a thread): none shorter than
+    ``smallest`` unless there is only one, a multiple of ``jobs`` when there are at least
+    ``jobs`` (range k is n * k // parts .. n * (k + 1) // parts: team.h edge)."""
+    return native.library().team_parts(n, jobs, smallest, 4)
 
 
 _LED = threading.local()  # the team this thread leads, while it does

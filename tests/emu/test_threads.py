@@ -22,14 +22,18 @@ def test_parts_are_a_few_per_thread_and_never_too_short(n, jobs, smallest, want)
     assert threads.parts(n, jobs, smallest) == want
 
 
-def test_parts_split_as_the_compiled_passes_do():
-    """threads.parts (the pairs' passes) and csrc/team.h parts_of (every compiled pass)
-    split alike, so that passes over the same rows split them at the same places."""
-    lib = native.library()
+def test_parts_keep_their_rules_over_a_grid():
+    """At most four a thread, a multiple of the threads when there are at least as many,
+    none shorter than smallest unless there is only one (smallest 0 counts as 1)."""
     for jobs in range(0, 10):
-        for smallest in (1, 2, 3, 7, 40, 4096):
+        for smallest in (0, 1, 2, 3, 7, 40, 4096):
             for n in (0, 1, 5, 17, 64, 100, 599, 20480, 10**6):
-                assert threads.parts(n, jobs, smallest) == lib.team_parts(n, jobs, smallest, 4), (n, jobs, smallest)
+                k = threads.parts(n, jobs, smallest)
+                assert 1 <= k <= max(1, 4 * jobs), (n, jobs, smallest, k)
+                assert k == 1 or n // k >= max(1, smallest), (n, jobs, smallest, k)
+                assert jobs <= 1 or k < jobs or k % jobs == 0, (n, jobs, smallest, k)
+                if jobs > 1 and n // max(1, smallest) >= jobs:
+                    assert k >= jobs, (n, jobs, smallest, k)
 
 
 def test_a_team_is_led_once_per_thread_and_ends_with_its_block():

@@ -357,8 +357,8 @@ Team *team_open_backwards(void)
     return t;
 }
 
-/* The split the passes take (team.h parts_of), for the check that threads.py parts takes
- * the same (tests/emu/test_threads.py). */
+/* The split the passes take (team.h parts_of), for the passes that Python splits
+ * (threads.py parts: the pairs' ranges), so that they split the rows alike. */
 int64_t team_parts(int64_t n, int32_t jobs, int64_t smallest, int64_t per_job)
 {
     return parts_of(n, jobs, smallest, per_job);

@@ -210,7 +210,7 @@ _PLAIN = {
     "have_avx512": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),
     "stream_scan": (None, [c_void_p, c_int64, c_int64, c_int32, c_int32, c_int32, c_void_p, c_void_p, c_int64,
-                           c_void_p]),
+                           c_void_p, c_int32]),
     "word_writes": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p]),
     "pairs_rows": (c_int64, [c_void_p, POINTER(Pairs), c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p,
                              c_int64, c_void_p]),
@@ -288,8 +288,8 @@ def runs(instruction_set: str) -> bool:
 
 
 def avx2() -> bool:
-    """Whether the pairs' decoding (csrc/kernels.c pair_marks), which has an AVX2 copy and
-    no other, takes it: under either vector build."""
+    """Whether the program's scan and the pairs' decoding (csrc/kernels.c stream_scan,
+    pair_marks), which have an AVX2 copy and no other, take it: under either vector build."""
     return isa() != "base"
 
 

@@ -125,7 +125,7 @@ class _Stream:
         room = max(0, len(prog.words) - start)
         lists, count = empty((_LISTS, room), np.int64), np.empty(_LISTS, np.int64)
         native.library().stream_scan(address(prog.words), len(prog.words), start, OPCODE.lo, OPCODE.width, FUNC.lo,
-                                     address(_KIND), address(lists), room, address(count))
+                                     address(_KIND), address(lists), room, address(count), native.avx2())
         # Addresses of the instructions per list (_KIND), in order; an SE's pair is one instruction.
         self.by_kind = [lists[k, :c] for k, c in enumerate(count.tolist())]
         self._find_stop()

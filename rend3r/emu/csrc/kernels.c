@@ -508,6 +508,36 @@ void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, con
 
 /* ---- the instruction processor (rend3r/emu/processor.py) ---- */
 
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#pragma GCC push_options
+#pragma GCC target("avx2")
+/* stream_scan's runs of pairs on AVX2, from word i on: whole blocks of eight pairs (16
+ * words below n) whose SE words all have the opcode se_op, their addresses into pair.
+ * Returns where it stopped. Built as vectors and stored two at a time, where the base
+ * build's loop gathered the SE words lane by lane and stored each address. */
+static int64_t scan_pairs8(const uint32_t *words, int64_t i, int64_t n, int32_t op_lo, uint32_t mask, uint32_t se_op,
+                           int64_t *pair)
+{
+    const i64x4 step = {0, 2, 4, 6};
+    for (; i + 16 <= n; i += 16, pair += 8) {
+        u32x8 lo, hi;
+        memcpy(&lo, words + i, sizeof lo);
+        memcpy(&hi, words + i + 8, sizeof hi);
+        u32x8 se = __builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14);
+        if (mask_bits_32x8((i32x8)(((se >> op_lo) & mask) == se_op)) != 255)
+            break;
+        i64x4 a0 = step + i, a1 = step + (i + 8);
+        memcpy(pair, &a0, sizeof a0);
+        memcpy(pair + 4, &a1, sizeof a1);
+    }
+    return i;
+}
+#pragma GCC pop_options
+#define SCAN8 1
+#else
+#define SCAN8 0
+#endif
+
 /* The instructions met reading words linearly from address start (_Stream): an SE word
  * takes the next word as its SD whatever that word is (an SE in the last word has none),
  * any other word is one instruction. Each instruction's address goes to a list, in address
@@ -516,9 +546,9 @@ void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, con
  * List k is lists + k * room (room: at least n - start); count[k] is how many it got. The counts stay
  * in locals (an array indexed by the kind put a store and a load on each word's path).
  * Runs of pairs are read eight pairs at a time (a 65,536-sphere program's 655,373 words
- * took 0.3 ms a word or a pair at a time). */
+ * took 0.3 ms a word or a pair at a time), with avx2 by scan_pairs8. */
 void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo, int32_t op_width, int32_t func_lo,
-                 const uint8_t *kind, int64_t *lists, int64_t room, int64_t *count)
+                 const uint8_t *kind, int64_t *lists, int64_t room, int64_t *count, int32_t avx2)
 {
     uint32_t mask = (1u << op_width) - 1u;
     int64_t *unknown = lists, *camera = lists + room, *light = lists + 2 * room, *pair = lists + 3 * room;
@@ -534,7 +564,12 @@ void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo,
         if (k == 3) {
             pair[c3++] = i;
             i += 2;
-            while (se_op >= 0 && i + 16 <= n) {  /* a run of pairs (a program's shapes): eight at a time */
+            if (SCAN8 && avx2 && se_op >= 0) {  /* a run of pairs (a program's shapes): eight at a time */
+                int64_t end = scan_pairs8(words, i, n, op_lo, mask, (uint32_t)se_op, pair + c3);
+                c3 += (end - i) / 2;
+                i = end;
+            }
+            while (!(SCAN8 && avx2) && se_op >= 0 && i + 16 <= n) {
                 u32x8 lo, hi;
                 memcpy(&lo, words + i, sizeof lo);
                 memcpy(&hi, words + i + 8, sizeof hi);

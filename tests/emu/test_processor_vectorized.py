@@ -399,10 +399,10 @@ _BREAK = st.one_of(_CAMERA, _LIGHT, _words(Func.NF), _SE_RUN, st.just([]))
 @given(st.lists(st.tuples(st.lists(_SHAPE_RUN, min_size=1, max_size=8), _BREAK), min_size=1, max_size=6),
        st.sampled_from(["raytrace", "hybrid"]), st.integers(1, 4))
 def test_pairs_back_to_back_decode_alike_on_both_instruction_sets(instruction_set, runs, mode, jobs):
-    """Long runs of pairs, which AVX2 scans and decodes eight at a time where they lie back
-    to back (csrc/kernels.c scan_pairs8, marks8), broken by other words at any pair, in
-    ranges of a few blocks on 1-4 threads: the scenes of the reference interpreter with the
-    baseline's loops and with the AVX2 blocks."""
+    """Long runs of pairs, which the scan and the decoding take eight at a time where they
+    lie back to back (csrc/kernels.c stream_scan, with AVX2 scan_pairs8 and marks8), broken
+    by other words at any pair, in ranges of a few blocks on 1-4 threads: the scenes of the
+    reference interpreter with the baseline's loops and with the AVX2 blocks."""
     from rend3r.emu import native
 
     if not native.runs(instruction_set):
@@ -412,7 +412,7 @@ def test_pairs_back_to_back_decode_alike_on_both_instruction_sets(instruction_se
     words = [NR] + [w for shapes, gap in runs for w in (*(w for shape in shapes for w in shape), *gap)] + [NF]
     options = EmuOptions(mode=mode, jobs=jobs)
     chunk = processor.PAIR_CHUNK
-    native.choose(instruction_set)  # (the pairs' decoding has no AVX-512 copy: avx2 covers both vector builds)
+    native.choose(instruction_set)  # (the scan and the pairs' decoding have no AVX-512 copy: avx2 covers both)
     processor.PAIR_CHUNK = 12  # ranges of a block or two on each thread
     try:
         got = _outcome(vectorized, words, options, None)

@@ -513,8 +513,9 @@ void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, con
 #pragma GCC target("avx2")
 /* stream_scan's runs of pairs on AVX2, from word i on: whole blocks of eight pairs (16
  * words below n) whose SE words all have the opcode se_op, their addresses into pair.
- * Returns where it stopped. Built as vectors and stored two at a time, where the base
- * build's loop gathered the SE words lane by lane and stored each address. */
+ * Returns where it stopped. The addresses are built as vectors and stored two at a time;
+ * the portable loop in stream_scan (without AVX2), compiled for baseline x86-64, put the
+ * SE words' vector together a word at a time and stored each address. */
 static int64_t scan_pairs8(const uint32_t *words, int64_t i, int64_t n, int32_t op_lo, uint32_t mask, uint32_t se_op,
                            int64_t *pair)
 {
@@ -564,11 +565,13 @@ void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo,
         if (k == 3) {
             pair[c3++] = i;
             i += 2;
-            if (SCAN8 && avx2 && se_op >= 0) {  /* a run of pairs (a program's shapes): eight at a time */
+#if SCAN8
+            if (avx2 && se_op >= 0) {  /* a run of pairs (a program's shapes): eight at a time */
                 int64_t end = scan_pairs8(words, i, n, op_lo, mask, (uint32_t)se_op, pair + c3);
                 c3 += (end - i) / 2;
                 i = end;
             }
+#endif
             while (!(SCAN8 && avx2) && se_op >= 0 && i + 16 <= n) {
                 u32x8 lo, hi;
                 memcpy(&lo, words + i, sizeof lo);

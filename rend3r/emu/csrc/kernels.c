@@ -569,10 +569,10 @@ void stream_scan(const uint32_t *words, int64_t n, int64_t start, int32_t op_lo,
             if (avx2 && se_op >= 0) {  /* a run of pairs (a program's shapes): eight at a time */
                 int64_t end = scan_pairs8(words, i, n, op_lo, mask, (uint32_t)se_op, pair + c3);
                 c3 += (end - i) / 2;
-                i = end;
+                i = end;  /* the loop below stops at the same block */
             }
 #endif
-            while (!(SCAN8 && avx2) && se_op >= 0 && i + 16 <= n) {
+            while (se_op >= 0 && i + 16 <= n) {
                 u32x8 lo, hi;
                 memcpy(&lo, words + i, sizeof lo);
                 memcpy(&hi, words + i + 8, sizeof hi);

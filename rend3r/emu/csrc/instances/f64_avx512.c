@@ -1,7 +1,6 @@
 /* The fp64 kernels for AVX-512 (instances.inc), which native.py uses where
  * have_avx512() says the processor runs them (AVX2, F16C and AVX-512 F, VL, BW and DQ): the
- * AVX2 kernels' 256-bit code (but for a float packet's colours, eight doubles: one 512-bit
- * register here, two there), whose compares, selects and conversions the compiler then
+ * AVX2 kernels' 256-bit code, whose compares, selects and conversions the compiler then
  * writes with the AVX-512 mask registers and three-operand logic; the same IEEE operations
  * lane by lane (no FMA: -ffp-contract=off). */
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))

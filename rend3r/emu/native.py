@@ -38,8 +38,8 @@ OUT_SHOWN, OUT_NAN_RAYS, OUT_COLUMNS = 10, 11, 12
 PC_COLUMNS, P32_COLUMNS = 7, 8  # primary cull data per shape, double and what float lanes read (float)
 BVH_CONE, BVH_FLAT = 0, 1  # a hierarchy's bounds around lines through one apex, or parallel lines
 BUILD_BYTES = 48  # bvh_build's working room a shape
-BV_SINE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 5, 6, 12  # their columns (csrc/kernels.h)
-BX_COLUMNS = 8  # a shape's own box on the axes normal to parallel lines (and rounded to floats)
+BV_SINE, BV_SIN2, BV_FLOOR, BV_COLUMNS = 3, 5, 6, 10  # their columns (csrc/kernels.h)
+BX_COLUMNS = 6  # a shape's own box on the axes normal to parallel lines, then rounded to floats (4 floats)
 CI_COLUMNS = 5  # a shape's own cone around an apex: unit axis, sine and cosine of its half-angle
 SK_COLUMNS, PK_COLUMNS = 6, 9  # a point light's behind terms per shape and per node (csrc/kernels.h)
 

@@ -55,17 +55,17 @@ static inline i64x4 cone_missed4(const double *b, f64x4 w0, f64x4 w1, f64x4 w2, 
  * below u|w|. NaN never lies outside. */
 static inline i32x8 cone_missed8(const double *b, f32x8 w0, f32x8 w1, f32x8 w2, f32x8 ww)
 {
-    return cross2_8((float)b[BV_AXIS32], (float)b[BV_AXIS32 + 1], (float)b[BV_AXIS32 + 2], w0, w1, w2)
-           > ww * (float)b[BV_SIN2_32];
+    const float *f = node32c(b, BV_F32);
+    return cross2_8(f[F32_AXIS], f[F32_AXIS + 1], f[F32_AXIS + 2], w0, w1, w2) > ww * f[F32_SIN2];
 }
 
 /* flat_missed4 for eight lanes in float: u and v rounded to floats, the box b32 (u0, u1,
  * v0, v1) rounded outwards (bounds.h round32). Rounding is monotonic, so u >= u0 gives
  * fl(u) >= fl(u0) >= b32[0], and likewise at the other sides: a lane inside the box is
  * never reported outside, whatever the magnitudes (overflow included). */
-static inline i32x8 flat_missed8(const double *b32, f32x8 u, f32x8 v)
+static inline i32x8 flat_missed8(const float *b32, f32x8 u, f32x8 v)
 {
-    return (u < (float)b32[0]) | (u > (float)b32[1]) | (v < (float)b32[2]) | (v > (float)b32[3]);
+    return (u < b32[0]) | (u > b32[1]) | (v < b32[2]) | (v > b32[3]);
 }
 
 /* Lanes whose parallel line, at (u, v) on the axes normal to the lines, lies outside a

@@ -383,9 +383,11 @@ static void refit_flat(const Bvh *t, const double *floor, double *box, const dou
             memcpy(node_keys + 3 * at, k, sizeof k);
         b[BV_U0] = u0; b[BV_U1] = u1; b[BV_V0] = v0; b[BV_V1] = v1;
         b[BV_FLOOR] = fl;
-        b[BV_FLOOR32] = floor32(fl);
-        b[BV_BOX32] = floor32(u0); b[BV_BOX32 + 1] = ceil32(u1);
-        b[BV_BOX32 + 2] = floor32(v0); b[BV_BOX32 + 3] = ceil32(v1);
+        float *f = node32(b, BV_F32);  /* floor32 and ceil32 give floats */
+        f[F32_FLOOR] = (float)floor32(fl);
+        f[F32_BOX] = (float)floor32(u0); f[F32_BOX + 1] = (float)ceil32(u1);
+        f[F32_BOX + 2] = (float)floor32(v0); f[F32_BOX + 3] = (float)ceil32(v1);
+        f[F32_PAD] = 0.0f;
     }
 }
 
@@ -446,14 +448,16 @@ static void refit_cones(const Bvh *t, const double *floor, double *box, const do
             }
         }
         b[BV_FLOOR] = fl;
-        b[BV_FLOOR32] = floor32(fl);
+        float *f = node32(b, BV_F32);  /* floor32 and ceil32 give floats */
+        f[F32_FLOOR] = (float)floor32(fl);
         double sine = b[BV_SINE];
         int cone = sine < CONE_EVERY && b[BV_AXIS] == b[BV_AXIS];
         b[BV_SIN2] = cone ? sine * sine * (1.0 + 1e-9) : INFINITY;
         for (int c = 0; c < 3; c++)
-            b[BV_AXIS32 + c] = (float)b[BV_AXIS + c];
-        b[BV_SIN2_32] = cone ? ceil32((sine * (1.0 + 1e-9) + 8 * U32) * (sine * (1.0 + 1e-9) + 8 * U32)
-                                      * (1.0 + 10 * U32)) : INFINITY;
+            f[F32_AXIS + c] = (float)b[BV_AXIS + c];
+        f[F32_SIN2] = cone ? (float)ceil32((sine * (1.0 + 1e-9) + 8 * U32) * (sine * (1.0 + 1e-9) + 8 * U32)
+                                           * (1.0 + 10 * U32)) : INFINITY;
+        f[F32_PAD] = 0.0f;
         if (keys != NULL)
             memcpy(node_keys + PK_COLUMNS * at, pk, sizeof pk);
     }

@@ -64,7 +64,7 @@ typedef struct {
     const Format *format;   /* the _fmt kernels' format (NULL for the others) */
 } Shapes;
 
-/* Shape hierarchy node columns (double, per bundle of rays; csrc/bvh.h): a bundle through
+/* Shape hierarchy node columns (doubles, then floats; per bundle of rays; csrc/bvh.h): a bundle through
  * one apex (BVH_CONE) gets the double cone holding the lines that meet the balls below
  * (unit axis, the sine and cosine of its half-angle, its squared sine widened), parallel
  * lines (BVH_FLAT) the box of the balls' discs on two axes normal to them; then the least
@@ -76,11 +76,19 @@ enum { BVH_CONE = 0, BVH_FLAT = 1 };
 /* Bytes a shape of bvh_build's working room: its Morton key twice, its centre and slot twice. */
 enum { BUILD_BYTES = 48 };
 enum { BV_AXIS = 0, BV_SINE = 3, BV_COS = 4, BV_SIN2 = 5, BV_U0 = 0, BV_U1 = 1, BV_V0 = 2, BV_V1 = 3,
-       BV_FLOOR = 6, BV_FLOOR32 = 7, BV_AXIS32 = 8, BV_SIN2_32 = 11, BV_BOX32 = 8, BV_COLUMNS = 12 };
+       BV_FLOOR = 6, BV_F32 = 7, BV_COLUMNS = 10 };
+/* The float columns, six floats from double column BV_F32 on (node32): the floor, then a
+ * cone's axis and squared sine or a box's u0, u1, v0, v1, and a zero. Read as floats where
+ * they were doubles converted at each read, they take conversions off every node a packet
+ * visits. */
+enum { F32_FLOOR = 0, F32_AXIS = 1, F32_SIN2 = 4, F32_BOX = 1, F32_PAD = 5 };
 /* Parallel lines also get each shape's own box (BV_U0..BV_V1), per item in leaf order;
- * boxes also come rounded outwards to floats (at BV_BOX32 of a node, BX_BOX32 of an item:
+ * boxes also come rounded outwards to floats (floats from double column BX_F32 of an item:
  * u0, u1, v0, v1; bvh.h flat_missed8). */
-enum { BX_BOX32 = 4, BX_COLUMNS = 8 };
+enum { BX_F32 = 4, BX_COLUMNS = 6 };
+/* A node's or an item's float columns, from double column `column` of its row on. */
+static inline float *node32(double *row, int column) { return (float *)(row + column); }
+static inline const float *node32c(const double *row, int column) { return (const float *)(row + column); }
 /* A shape's own cone for lines through one apex (unit axis, the sine and cosine of its
  * half-angle: sine inf for every line), per item in leaf order, while the nodes' cones
  * are fitted (kernels.c bvh_refit). */

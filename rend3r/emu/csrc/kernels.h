@@ -64,8 +64,8 @@ typedef struct {
     const Format *format;   /* the _fmt kernels' format (NULL for the others) */
 } Shapes;
 
-/* Shape hierarchy node columns (doubles, then floats; per bundle of rays; csrc/bvh.h): a bundle through
- * one apex (BVH_CONE) gets the double cone holding the lines that meet the balls below
+/* Shape hierarchy node columns (doubles, then floats; per bundle of rays; csrc/bvh.h): a
+ * bundle through one apex (BVH_CONE) gets the double cone holding the lines that meet the balls below
  * (unit axis, the sine and cosine of its half-angle, its squared sine widened), parallel
  * lines (BVH_FLAT) the box of the balls' discs on two axes normal to them; then the least
  * depth floor below, and that

@@ -125,3 +125,21 @@ def test_equal_spheres_at_equal_depth_keep_the_lower_index():
     _same(p, EmuOptions(width=40, height=30))
     frame, _ = render_frame(_scene(p), EmuOptions(width=40, height=30))
     assert set(np.unique(frame.provenance)) <= {-1, 5}
+
+
+@pytest.mark.parametrize("dmin", [1e160, np.inf])
+def test_a_squared_direction_length_that_overflows_bounds_nothing(dmin):
+    """fp64's overflow threshold is infinite, so the cull radius's cap on |S| is
+    sqrt(1 + inf / |D|^2): NaN once |D|^2 overflows, and the shape is then left unbounded
+    (a shortcut that skipped the cap gave such shapes a finite radius)."""
+    from rend3r.emu import bvh, native
+
+    bnd = np.zeros((8, native.B_COLUMNS))
+    bnd[:, 2] = -10.0 - np.arange(8)
+    bnd[:, native.B_SMIN] = bnd[:, native.B_SMAX] = 1.0
+    ar = make_arith("fp64", "ftz")
+    assert ar.overflow == np.inf
+    ok = np.ones(8, bool)
+    p = bounds.primary(bnd, ok, np.zeros(3), dmin, dmin, ar.unit_roundoff, ar.tiny, ar.overflow)
+    bvh.build(bnd, ok).fit(p, apex=np.zeros(3))
+    assert (p.radius == np.inf).all()

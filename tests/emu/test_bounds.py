@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from rend3r.emu import bounds
+from rend3r.emu import bounds, bvh, native
 from rend3r.emu.arith import make_arith
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.processor import execute
@@ -132,8 +132,6 @@ def test_a_squared_direction_length_that_overflows_bounds_nothing(dmin):
     """fp64's overflow threshold is infinite, so the cull radius's cap on |S| is
     sqrt(1 + inf / |D|^2): NaN once |D|^2 overflows, and the shape is then left unbounded
     (a shortcut that skipped the cap gave such shapes a finite radius)."""
-    from rend3r.emu import bvh, native
-
     bnd = np.zeros((8, native.B_COLUMNS))
     bnd[:, 2] = -10.0 - np.arange(8)
     bnd[:, native.B_SMIN] = bnd[:, native.B_SMAX] = 1.0

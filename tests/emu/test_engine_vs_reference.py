@@ -12,9 +12,8 @@ tests/emu/test_engine_vs_reference.py`` draws ten times as many from a random on
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import os
+from dataclasses import replace
 
 import numpy as np
 import pytest

@@ -3,7 +3,8 @@ log(shapes).
 
 Built once per frame from the shapes' centres (``csrc/kernels.c`` bvh_build: splits along
 a Morton curve of the centres, halving the longest side of a node's cell first, leaves of
-at most 4 shapes); each bundle of rays then refits its
+at most 4 shapes), or copied from the thread's last frame when the shapes did not move
+(:func:`memo`); each bundle of rays then refits its
 node bounds to the balls of its own cull radii, and its depth floors (bvh_refit): double
 cones around the apex of lines through one point, boxes on the plane normal to parallel
 lines. Shapes without a
@@ -13,6 +14,7 @@ skipping a node never changes the nearest hit.
 
 from __future__ import annotations
 
+import threading
 from ctypes import byref
 from dataclasses import dataclass, field
 
@@ -124,9 +126,44 @@ class Bounds:
                           None if self.item_box is None else address(self.item_box), address(t.where))
 
 
-def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
+class _Memo(threading.local):
+    """This thread's last tree (``csrc/kernels.h`` TreeMemo): its inputs and outputs, in
+    arrays of its own that no frame's array shares."""
+
+    def __init__(self) -> None:
+        self.arrays: tuple[np.ndarray, ...] = ()
+        self.block = native.TreeMemo()
+
+
+_memo = _Memo()
+
+
+def memo(rows: int) -> native.TreeMemo:
+    """This thread's tree memo with room for ``rows`` shapes: ``csrc/kernels.c`` bvh_build
+    copies the tree kept there when the shapes' centres, and which are bounded, are those
+    of the last build, as a renderer keeps a scene's hierarchy between frames (the memo
+    grows with the largest frame the thread renders: 44 bytes a shape)."""
+    block = _memo.block
+    if block.capacity < rows:
+        cap = max(1, rows)
+        given, always, items, where = np.empty(cap * native.BUILD_ITEM_BYTES, np.uint8), np.empty(cap, np.int32), \
+            np.empty(cap, np.int32), np.empty(cap, np.int32)
+        node = np.empty((2 * cap, 2), np.int32)
+        _memo.arrays = (given, always, items, where, node)
+        _memo.block = block = native.TreeMemo(cap, 0, 0, (0, 0), 0, 0, *(address(a) for a in _memo.arrays))
+    return block
+
+
+def forget() -> None:
+    """Drops this thread's kept tree: the next frame builds its own (benchmarks time a
+    program's first frame so)."""
+    _memo.block.valid = 0
+
+
+def build(bnd: np.ndarray, bounded: np.ndarray, kept: native.TreeMemo | None = None) -> Tree:
     """The hierarchy over the shapes of the bound table ``bnd`` (n, B_COLUMNS) that are
-    ``bounded`` with a finite centre; the others go to the list every ray tests."""
+    ``bounded`` with a finite centre; the others go to the list every ray tests. ``kept``
+    (a :func:`memo`) keeps the tree, or gives it when it holds this one."""
     n = len(bnd)
     native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
     ok = np.ascontiguousarray(bounded, np.uint8)  # 0 or 1 (bool or uint8 given)
@@ -135,5 +172,6 @@ def build(bnd: np.ndarray, bounded: np.ndarray) -> Tree:
     node, counts, room = np.empty((max(1, 2 * n), 2), np.int32), np.zeros(2, np.int64), \
         empty(n * native.BUILD_BYTES // 8, np.uint64)
     nodes = native.library().bvh_build(address(bnd), address(ok), n, address(items), address(always), address(where),
-                                       address(node), address(counts), address(room), 0)  # new arrays: all written
+                                       address(node), address(counts), address(room), 0,
+                                       None if kept is None else byref(kept))
     return Tree(node[:nodes], items[:counts[0]], always[:counts[1]], where)

@@ -37,7 +37,7 @@ OUT_TESTS, OUT_NAN_TESTS, OUT_SHADOW_RAYS, OUT_HITS, OUT_LO, OUT_HI = 0, 1, 2, 3
 OUT_SHOWN, OUT_NAN_RAYS, OUT_COLUMNS = 10, 11, 12
 PC_COLUMNS, P32_COLUMNS = 7, 8  # primary cull data per shape, double and what float lanes read (float)
 BVH_CONE, BVH_FLAT = 0, 1  # a hierarchy's bounds around lines through one apex, or parallel lines
-BUILD_BYTES = 48  # bvh_build's working room a shape
+BUILD_BYTES, BUILD_ITEM_BYTES = 48, 16  # bvh_build's working room a shape, and a shape's centre and slot
 BV_SINE, BV_SIN2, BV_FLOOR, BV_F32, BV_COLUMNS = 3, 5, 6, 7, 10  # their columns; floats from BV_F32 on (csrc/kernels.h)
 BX_COLUMNS = 6  # a shape's own box on the axes normal to parallel lines, then rounded to floats (4 floats)
 CI_COLUMNS = 5  # a shape's own cone around an apex: unit axis, sine and cosine of its half-angle
@@ -107,6 +107,14 @@ class LightPass(Structure):
                 ("point_keys", c_void_p), ("serial", c_int64)]
 
 
+class TreeMemo(Structure):
+    """A thread's last tree (csrc/kernels.h TreeMemo, bvh.py memo)."""
+
+    _fields_ = [("capacity", c_int64), ("valid", c_int64), ("rows", c_int64), ("counts", c_int64 * 2),
+                ("nodes", c_int64), ("copies", c_int64), ("given", c_void_p), ("always", c_void_p), ("items", c_void_p),
+                ("where", c_void_p), ("node", c_void_p)]
+
+
 class Setup(Structure):
     """A frame's set-up (csrc/kernels.h Setup, csrc/setup.c frame_setup)."""
 
@@ -115,7 +123,7 @@ class Setup(Structure):
                 ("sf", c_void_p), ("sf_row", c_int64), ("si", c_void_p), ("bnd", c_void_p), ("bounded", c_void_p),
                 ("index_out", c_void_p), ("items", c_void_p), ("always", c_void_p), ("node", c_void_p),
                 ("where", c_void_p),
-                ("room", c_void_p), ("counts", c_int64 * 2), ("nodes", c_int64), ("shapes", c_int64), ("jobs", c_int32),
+                ("room", c_void_p), ("memo", c_void_p), ("counts", c_int64 * 2), ("nodes", c_int64), ("shapes", c_int64), ("jobs", c_int32),
                 ("chunk", c_int64)]
 
 
@@ -205,7 +213,7 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
 }
 _PLAIN = {
     "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p,
-                            c_int32]),
+                            c_int32, c_void_p]),
     "have_avx2": (c_int32, []),
     "have_avx512": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),

@@ -10,7 +10,8 @@ image does not depend on it). Per band:
    camera's directions; a grid camera's come from its axes, once per frame);
 2. the shape hierarchy's boxes for the primary rays, from the shapes' cull radii and
    depth floors (:mod:`.bvh`, :mod:`.bounds`; the tree itself is built once per frame,
-   and for a grid camera these bounds too, shared by its bands);
+   or kept from the frame before when the shapes did not move, and for a grid camera
+   these bounds too, shared by its bands);
 3. the nearest hit of every pixel, its hit point and normal (``nearest``, packets of a
    row's pixels walking the tree nearest node first);
 4. per light, the hierarchy's boxes for its shadow rays, from the box of the band's hit
@@ -26,7 +27,7 @@ never changes a pixel; :mod:`.reference` is the plain renderer the tests compare
 from __future__ import annotations
 
 import math
-from ctypes import byref, pointer
+from ctypes import addressof, byref, pointer
 from dataclasses import dataclass
 from time import perf_counter
 from typing import Callable
@@ -237,7 +238,7 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
                                                            address(bounded), address(out))
     room = bvh.Tree(node, items, always, where)
     s.node, s.items, s.always, s.where = address(room.node), address(room.items), address(room.always), address(where)
-    s.room = address(build)
+    s.room, s.memo = address(build), addressof(bvh.memo(rows))
     s.jobs, s.chunk = jobs, bounds.SHAPE_CHUNK
     first = None
     if extent is not None:  # the primary bounds in the same call, around the camera origin

@@ -327,3 +327,91 @@ def test_point_light_terms_hold_every_shape_below(n, seed):
         assert k[6] == t[:, 3].min()
         assert k[7] == (np.inf if np.isnan(t[:, 4]).any() else t[:, 4].max())
         assert k[8] == t[:, 5].max()
+
+
+def _same_tree(a: bvh.Tree, b: bvh.Tree) -> bool:
+    return all(np.array_equal(x, y) for x, y in ((a.node, b.node), (a.items, b.items), (a.always, b.always),
+                                                 (a.where, b.where)))
+
+
+@settings(max_examples=40, derandomize=True)
+@given(st.integers(0, 2000), st.integers(0, 2**32 - 1), st.sampled_from(["moved", "float ulp", "unbounded",
+                                                                          "swapped", "fewer", "more"]))
+def test_a_kept_tree_is_copied_only_for_the_same_shapes(n, seed, change):
+    """bvh_build copies the tree a memo keeps when the centres (as floats), slots and
+    unbounded shapes are the last build's, and builds every other: each tree is the one
+    built without a memo."""
+    rng = np.random.default_rng(seed)
+    centers = rng.normal(size=(n, 3)) * (rng.random((n, 1)) < 0.5)  # ties among the centres
+    bounded = rng.random(n) < 0.9
+    kept = bvh.memo(n + 1)
+    kept.valid = 0
+    first = bvh.build(table(centers), bounded, kept)
+    assert _same_tree(first, bvh.build(table(centers), bounded))
+    copies = kept.copies
+    again = bvh.build(table(centers), bounded, kept)
+    assert _same_tree(again, first) and kept.copies == copies + (len(first.items) > 0)  # none kept: no tree
+    other, ok = centers.copy(), bounded.copy()
+    i = int(rng.integers(0, n)) if n else 0
+    if change == "fewer":
+        other, ok = other[:-1], ok[:-1]
+    elif change == "more":
+        other, ok = np.vstack([other, [[0.5, 0.25, 2.0]]]), np.append(ok, True)
+    elif n == 0:
+        return
+    elif change == "moved":
+        other[i, int(rng.integers(0, 3))] += 1.0
+    elif change == "float ulp":  # the build reads centres as floats: one float step apart
+        c = np.float32(other[i, 0])
+        other[i, 0] = np.nextafter(c, np.float32(np.inf), dtype=np.float32)
+    elif change == "unbounded":
+        ok[i] = not ok[i]
+    elif change == "swapped":  # the same centres in other slots
+        j = (i + 1) % n
+        other[[i, j]] = other[[j, i]]
+        ok[[i, j]] = ok[[j, i]]
+    same = len(ok) == n and np.array_equal(ok, bounded) and \
+        other[ok].astype(np.float32).tobytes() == centers[ok].astype(np.float32).tobytes()  # -0 is not 0 here
+    copies = kept.copies
+    built = bvh.build(table(other), ok, kept)
+    assert _same_tree(built, bvh.build(table(other), ok))
+    assert kept.copies == copies + (same and len(first.items) > 0)
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_frames_of_moving_shapes_match_frames_built_afresh(jobs):
+    """Frames alternating between scenes, their shapes moved or not, render as each scene's
+    first frame does, test counts included (those depend on the tree's grouping: the kept
+    tree is copied only for the same shapes)."""
+    from rend3r.asm.assembler import assemble_source
+    from rend3r.emu.options import EmuOptions
+    from rend3r.emu.run import run_program
+
+    grid = [(x - 1.5, y - 1.5) for y in range(4) for x in range(4)]
+
+    def scene(order: list[int]) -> list[int]:
+        lines = ["nr", "cam rrot, 1", "cam hfov, 0.25", "cam vfov, 0.25", "lt 0, src, 1", "lt 0, xfor, -1",
+                 "lt 0, yfor, -1", "lt 0, zfor, -1", "lt 0, col, 0xFFFF", "lt 0, int, 1"]
+        for k, at in enumerate(order):
+            x, y = grid[at]
+            lines += [f"sp {k}, type, col, 1, {0x0841 * (k + 1)}", f"sp {k}, xloc, yloc, {x}, {y}",
+                      f"sp {k}, zloc, rrot, -8, 1", f"sp {k}, xscl, yscl, 2.5, 2.5", f"sp {k}, zscl, mat, 2.5, 0"]
+        made = assemble_source("\n".join([*lines, "nf", "er"]))
+        assert made.ok, made.format_diagnostics()
+        return made.program.words
+
+    same, swapped = list(range(16)), list(range(16))
+    swapped[3], swapped[12] = 12, 3  # two shapes change places: the same centres, other slots
+    options = EmuOptions(precision="fp32", width=64, height=48, jobs=jobs)
+    scenes = [scene(order) for order in (same, same, swapped, same, swapped, swapped, same[::-1])]
+    copies = bvh.memo(0).copies
+    runs = [run_program(words, options) for words in scenes]
+    assert bvh.memo(0).copies == copies + 2
+    for words, run in zip(scenes, runs):
+        bvh.forget()
+        fresh = run_program(words, options)
+        mine, theirs = run.frames[0], fresh.frames[0]
+        assert np.array_equal(mine.provenance, theirs.provenance) and np.array_equal(mine.rgb565, theirs.rgb565)
+        assert mine.depth.tobytes() == theirs.depth.tobytes()
+        counts = [(st.tests, st.skipped, st.hits) for st in (run.stats.frames[0], fresh.stats.frames[0])]
+        assert counts[0] == counts[1]

@@ -59,6 +59,7 @@ int32_t have_avx512(void)
  * splits walk one small array instead of following slots into the bound table. */
 typedef struct { float c[3]; int32_t slot; } BuildItem;
 _Static_assert(2 * sizeof(BuildItem) + 2 * sizeof(uint64_t) == BUILD_BYTES, "bvh_build's room a shape");
+_Static_assert(sizeof(BuildItem) == BUILD_ITEM_BYTES, "a tree memo's shape");
 
 /* Reorders a[lo..hi) so that a[k] has the centre coordinate `axis` that sorting would give
  * it, none before it larger and none after it smaller (quickselect). */
@@ -151,6 +152,47 @@ static inline void put(int32_t *at, int32_t v, int32_t keep)
         *at = v;
 }
 
+/* to[0..n) = from[0..n), with keep written only where it differs. */
+static void put_all(int32_t *to, const int32_t *from, int64_t n, int32_t keep)
+{
+    if (!keep) {
+        memcpy(to, from, (size_t)n * sizeof *to);
+        return;
+    }
+    for (int64_t i = 0; i < n; i++)
+        put(to + i, from[i], keep);
+}
+
+/* Whether memo holds the tree of these inputs: rows rows, the n bounded shapes as given
+ * (a) and the outside ones (always). */
+static int memo_holds(const TreeMemo *memo, int64_t rows, const BuildItem *a, int64_t n, const int32_t *always,
+                      int64_t outside)
+{
+    return memo != NULL && memo->valid && memo->rows == rows && memo->counts[0] == n && memo->counts[1] == outside &&
+           memcmp(memo->given, a, (size_t)n * sizeof *a) == 0 &&
+           memcmp(memo->always, always, (size_t)outside * sizeof *always) == 0;
+}
+
+/* Keeps a build's inputs and outputs in memo when they fit (else memo holds none). */
+static void memo_keep(TreeMemo *memo, int64_t rows, const BuildItem *a, int64_t n, const int32_t *always,
+                      int64_t outside, const int32_t *items, const int32_t *where, const int32_t *node, int64_t nodes)
+{
+    if (memo == NULL)
+        return;
+    memo->valid = rows <= memo->capacity;
+    if (!memo->valid)
+        return;
+    memcpy(memo->given, a, (size_t)n * sizeof *a);
+    memcpy(memo->always, always, (size_t)outside * sizeof *always);
+    memcpy(memo->items, items, (size_t)n * sizeof *items);
+    memcpy(memo->where, where, (size_t)rows * sizeof *where);
+    memcpy(memo->node, node, (size_t)nodes * 2 * sizeof *node);
+    memo->rows = rows;
+    memo->counts[0] = n;
+    memo->counts[1] = outside;
+    memo->nodes = nodes;
+}
+
 /* The hierarchy over the shapes of bnd (n rows) that are bounded with a finite centre;
  * their slots go to items (count[0] of them), the others' to always (count[1]). The
  * shapes are ordered along a Morton curve of their centres, quantised to 2**MORTON_BITS
@@ -166,9 +208,11 @@ static inline void put(int32_t *at, int32_t v, int32_t keep)
  * With keep (other threads read the tree), items, always, where and node are written
  * only where they differ: the tree depends on the centres alone, and a frame whose shapes
  * did not move then leaves the last frame's in the other threads' caches
- * (docs/performance-history.md, "Rows left alone"). Returns the node count. */
+ * (docs/performance-history.md, "Rows left alone"). memo (NULL: none) keeps the last
+ * tree: when it holds these inputs' tree, that is copied rather than built again. Returns
+ * the node count. */
 int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
-                  int32_t *where, int32_t *node, int64_t *count_out, void *room, int32_t keep)
+                  int32_t *where, int32_t *node, int64_t *count_out, void *room, int32_t keep, TreeMemo *memo)
 {
     int64_t stack[4 * BVH_STACK], top = 1, count = 0, n = 0, outside = 0;
     count_out[0] = count_out[1] = 0;
@@ -189,10 +233,18 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     }
     count_out[0] = n;
     count_out[1] = outside;
+    if (memo_holds(memo, rows, a, n, always, outside)) {
+        put_all(items, memo->items, n, keep);
+        put_all(where, memo->where, rows, keep);
+        put_all(node, memo->node, 2 * memo->nodes, keep);
+        memo->copies++;
+        return memo->nodes;
+    }
     for (int64_t k = 0; k < outside; k++)
         put(where + always[k], (int32_t)(n + k), keep);
     if (n == 0)
         return 0;
+    const BuildItem *given = a;
     double side = MAX(MAX((double)hi3[0] - lo3[0], (double)hi3[1] - lo3[1]), (double)hi3[2] - lo3[2]);
     double scale = side > 0 && side < INFINITY ? (double)(1 << MORTON_BITS) / side : 0.0;  /* else one code */
     for (int64_t i = 0; i < n; i++) {
@@ -256,6 +308,7 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
         put(items + i, a[i].slot, keep);
         put(where + a[i].slot, (int32_t)i, keep);
     }
+    memo_keep(memo, rows, given, n, always, outside, items, where, node, count);
     return count;
 }
 

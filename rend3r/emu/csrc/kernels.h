@@ -73,8 +73,9 @@ typedef struct {
  * widened squared sine of the float test (bvh.h cone_missed8), a box its bounds rounded
  * outwards to floats. */
 enum { BVH_CONE = 0, BVH_FLAT = 1 };
-/* Bytes a shape of bvh_build's working room: its Morton key twice, its centre and slot twice. */
-enum { BUILD_BYTES = 48 };
+/* Bytes a shape of bvh_build's working room (its Morton key twice, its centre and slot
+ * twice), and of its centre and slot (kernels.c BuildItem). */
+enum { BUILD_BYTES = 48, BUILD_ITEM_BYTES = 16 };
 enum { BV_AXIS = 0, BV_SINE = 3, BV_COS = 4, BV_SIN2 = 5, BV_U0 = 0, BV_U1 = 1, BV_V0 = 2, BV_V1 = 3,
        BV_FLOOR = 6, BV_F32 = 7, BV_COLUMNS = 10 };
 /* The float columns, six floats from double column BV_F32 on (node32): the floor, then a
@@ -178,6 +179,19 @@ typedef int64_t (*ShapeTablesFn)(const uint16_t *values, const int64_t *index, i
                                  double *bnd, uint8_t *bounded, int32_t *index_out, const Format *format,
                                  int32_t keep);
 
+/* The last tree a thread's bvh_build made, kept from frame to frame (raytracer.py
+ * _TreeMemo): the tree depends on the bounded shapes' float centres and slots and on the
+ * shapes outside it alone, so a frame whose shapes did not move copies it instead of
+ * building it again, as a renderer keeps a scene's hierarchy between frames. */
+typedef struct {
+    int64_t capacity;       /* rows the arrays below have room for */
+    int64_t valid;          /* 1: they hold the inputs and outputs of the last build */
+    int64_t rows, counts[2], nodes;
+    int64_t copies;         /* the builds that copied it, since it was made */
+    void *given;            /* capacity x BUILD_ITEM_BYTES: the bounded shapes as given (kernels.c BuildItem) */
+    int32_t *always, *items, *where, *node; /* capacity each, node 2 x max(1, 2 capacity) */
+} TreeMemo;
+
 typedef struct {            /* a frame's set-up (setup.c frame_setup) */
     ShapeTablesFn tables;
     const uint16_t *values; /* the object table: rows x PROP_WORDS, and each row's program index */
@@ -196,6 +210,7 @@ typedef struct {            /* a frame's set-up (setup.c frame_setup) */
     int32_t *items, *always, *node; /* out, room for rows, rows and max(1, 2 rows) nodes: the tree */
     int32_t *where;         /* out, room for rows: per shape its row in a light's bounds (bvh_build) */
     void *room;             /* rows x BUILD_BYTES, 8-byte aligned: the build's working copies */
+    TreeMemo *memo;         /* the calling thread's last tree, NULL: none kept */
     int64_t counts[2];      /* out: the tree's items and the shapes outside it */
     int64_t nodes;          /* out: its nodes */
     int64_t shapes;         /* out: the shapes on */

@@ -3,8 +3,8 @@ log(shapes).
 
 Built once per frame from the shapes' centres (``csrc/kernels.c`` bvh_build: splits along
 a Morton curve of the centres, halving the longest side of a node's cell first, leaves of
-at most 4 shapes), or copied from the thread's last frame when the shapes did not move
-(:func:`memo`); each bundle of rays then refits its
+at most 4 shapes), or found where the thread's last frame built it when the shapes did not
+move (:func:`tree_room`); each bundle of rays then refits its
 node bounds to the balls of its own cull radii, and its depth floors (bvh_refit): double
 cones around the apex of lines through one point, boxes on the plane normal to parallel
 lines. Shapes without a
@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import bounds as shape_bounds, native, threads
+from . import bounds as shape_bounds, native, threads, workspace
 from .native import address
 from .workspace import arrays, empty
 
@@ -126,52 +126,58 @@ class Bounds:
                           None if self.item_box is None else address(self.item_box), address(t.where))
 
 
-class _Memo(threading.local):
-    """This thread's last tree (``csrc/kernels.h`` TreeMemo): its inputs and outputs, in
-    arrays of its own that no frame's array shares."""
+class _Room(threading.local):
+    """This thread's tree arrays (node, items, always, where) and the shapes its builds
+    were given, with the kernels' memo of them (``csrc/kernels.h`` TreeMemo)."""
 
     def __init__(self) -> None:
-        self.arrays: tuple[np.ndarray, ...] = ()
+        self.arrays: list[np.ndarray] = []
         self.block = native.TreeMemo()
 
 
-_memo = _Memo()
+_room = _Room()
 
 
-def memo(rows: int) -> native.TreeMemo:
-    """This thread's tree memo with room for ``rows`` shapes: ``csrc/kernels.c`` bvh_build
-    copies the tree kept there when the shapes' centres, and which are bounded, are those
-    of the last build, as a renderer keeps a scene's hierarchy between frames (the memo
-    grows with the largest frame the thread renders: 44 bytes a shape)."""
-    block = _memo.block
-    if block.capacity < rows:
-        cap = max(1, rows)
-        given, always, items, where = np.empty(cap * native.BUILD_ITEM_BYTES, np.uint8), np.empty(cap, np.int32), \
-            np.empty(cap, np.int32), np.empty(cap, np.int32)
-        node = np.empty((2 * cap, 2), np.int32)
-        _memo.arrays = (given, always, items, where, node)
-        _memo.block = block = native.TreeMemo(cap, 0, 0, (0, 0), 0, 0, *(address(a) for a in _memo.arrays))
-    return block
+def tree_room(rows: int) -> tuple[native.TreeMemo, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """This thread's memo and the arrays to build a tree of ``rows`` shapes in: (memo,
+    node, items, always, where), each with room for ``rows`` (node for 2 ``rows``).
+    ``csrc/kernels.c`` bvh_build given them finds there the tree of its last build, and
+    builds nothing, when the shapes' centres and which are bounded are that build's, as a
+    renderer keeps a scene's hierarchy between frames. They are this thread's from frame
+    to frame while no array made from them lives (else new ones are made) and grow with the
+    largest frame: 60 bytes a shape."""
+    room = _room
+    if not room.arrays or room.block.capacity < rows or not workspace.unshared(room.arrays):
+        cap = max(1, rows + rows // 8)  # a scene that grows a little keeps its room
+        room.arrays = [np.empty((2 * cap, 2), np.int32), np.empty(cap, np.int32), np.empty(cap, np.int32),
+                       np.empty(cap, np.int32), np.empty(2 * cap * native.BUILD_ITEM_BYTES, np.uint8)]
+        room.block = native.TreeMemo(capacity=cap, given=address(room.arrays[4]))
+    node, items, always, where, _ = room.arrays
+    return room.block, node, items, always, where
 
 
 def forget() -> None:
-    """Drops this thread's kept tree: the next frame builds its own (benchmarks time a
-    program's first frame so)."""
-    _memo.block.valid = 0
+    """Makes this thread's next tree build build (benchmarks time a program's first frame
+    so)."""
+    _room.block.valid = 0
 
 
-def build(bnd: np.ndarray, bounded: np.ndarray, kept: native.TreeMemo | None = None) -> Tree:
+def build(bnd: np.ndarray, bounded: np.ndarray, kept: bool = False) -> Tree:
     """The hierarchy over the shapes of the bound table ``bnd`` (n, B_COLUMNS) that are
-    ``bounded`` with a finite centre; the others go to the list every ray tests. ``kept``
-    (a :func:`memo`) keeps the tree, or gives it when it holds this one."""
+    ``bounded`` with a finite centre; the others go to the list every ray tests. With
+    ``kept``, built in this thread's :func:`tree_room` (and copied out of it)."""
     n = len(bnd)
     native.ptr(bnd, np.float64, (n, native.B_COLUMNS))
     ok = np.ascontiguousarray(bounded, np.uint8)  # 0 or 1 (bool or uint8 given)
     native.ptr(ok, np.uint8, (n,))
-    items, always, where = np.empty(n, np.int32), np.empty(n, np.int32), np.empty(n, np.int32)
-    node, counts, room = np.empty((max(1, 2 * n), 2), np.int32), np.zeros(2, np.int64), \
-        empty(n * native.BUILD_BYTES // 8, np.uint64)
+    if kept:
+        memo, node, items, always, where = tree_room(n)
+    else:
+        memo, node, items, always, where = None, np.empty((max(1, 2 * n), 2), np.int32), np.empty(n, np.int32), \
+            np.empty(n, np.int32), np.empty(n, np.int32)
+    counts, room = np.zeros(2, np.int64), empty(n * native.BUILD_BYTES // 8, np.uint64)
     nodes = native.library().bvh_build(address(bnd), address(ok), n, address(items), address(always), address(where),
                                        address(node), address(counts), address(room), 0,
-                                       None if kept is None else byref(kept))
-    return Tree(node[:nodes], items[:counts[0]], always[:counts[1]], where)
+                                       None if memo is None else byref(memo))
+    tree = Tree(node[:nodes], items[:counts[0]], always[:counts[1]], where[:n])
+    return Tree(*(a.copy() for a in (tree.node, tree.items, tree.always, tree.where))) if kept else tree

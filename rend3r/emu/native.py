@@ -108,11 +108,11 @@ class LightPass(Structure):
 
 
 class TreeMemo(Structure):
-    """A thread's last tree (csrc/kernels.h TreeMemo, bvh.py memo)."""
+    """What a thread's tree builds keep (csrc/kernels.h TreeMemo, bvh.py TreeRoom)."""
 
     _fields_ = [("capacity", c_int64), ("valid", c_int64), ("rows", c_int64), ("counts", c_int64 * 2),
-                ("nodes", c_int64), ("copies", c_int64), ("given", c_void_p), ("always", c_void_p), ("items", c_void_p),
-                ("where", c_void_p), ("node", c_void_p)]
+                ("nodes", c_int64), ("kept", c_int64), ("last", c_int64), ("given", c_void_p), ("items", c_void_p),
+                ("always", c_void_p), ("where", c_void_p), ("node", c_void_p)]
 
 
 class Setup(Structure):

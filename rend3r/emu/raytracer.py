@@ -230,15 +230,16 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
     s = native.Setup(native.kernel_address("shape_tables", ar),
                      native.ptr(values, np.uint16, (rows, PROP_LIMIT)), address(index), rows, address(_SHAPE_PROPS),
                      address(_KINDS), native.ptr(cam, dtype, (native.CAM_COLUMNS,)), ar.tiny, fmt)
-    sf, si, bnd, bounded, out, node, items, always, where, build = arrays(  # frame_setup fills them; build: its
-        ((rows, native.SF_COLUMNS), dtype), ((rows, native.SI_COLUMNS), np.int64),  # working copies
-        ((rows, native.B_COLUMNS), np.float64), (rows, np.uint8), (rows, np.int32), ((max(1, 2 * rows), 2), np.int32),
-        (rows, np.int32), (rows, np.int32), (rows, np.int32), (rows * native.BUILD_BYTES // 8, np.uint64))
+    sf, si, bnd, bounded, out, build = arrays(  # frame_setup fills them; build: its working copies
+        ((rows, native.SF_COLUMNS), dtype), ((rows, native.SI_COLUMNS), np.int64),
+        ((rows, native.B_COLUMNS), np.float64), (rows, np.uint8), (rows, np.int32),
+        (rows * native.BUILD_BYTES // 8, np.uint64))
+    memo, node, items, always, where = bvh.tree_room(rows)  # the tree: this thread's, from frame to frame
     s.sf, s.sf_row, s.si, s.bnd, s.bounded, s.index_out = (address(sf), sf.strides[0], address(si), address(bnd),
                                                            address(bounded), address(out))
-    room = bvh.Tree(node, items, always, where)
+    room = bvh.Tree(node[:max(1, 2 * rows)], items[:rows], always[:rows], where[:rows])
     s.node, s.items, s.always, s.where = address(room.node), address(room.items), address(room.always), address(where)
-    s.room, s.memo = address(build), addressof(bvh.memo(rows))
+    s.room, s.memo = address(build), addressof(memo)
     s.jobs, s.chunk = jobs, bounds.SHAPE_CHUNK
     first = None
     if extent is not None:  # the primary bounds in the same call, around the camera origin

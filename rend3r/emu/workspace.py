@@ -60,6 +60,12 @@ def _refs(buffers: list[np.ndarray], i: int) -> int:
     return sys.getrefcount(buffers[i])
 
 
+def unshared(kept: list[np.ndarray]) -> bool:
+    """Whether the list alone refers to each array of ``kept`` (no array made from one
+    lives); False when that cannot be told."""
+    return _FREE is not None and all(_refs(kept, i) == _FREE for i in range(len(kept)))
+
+
 def _calibrate() -> int | None:
     """What _refs gives for a buffer that only the list holds (the interpreter's own
     references depend on its version), checked against a buffer with a view alive; None

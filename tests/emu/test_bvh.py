@@ -334,23 +334,26 @@ def _same_tree(a: bvh.Tree, b: bvh.Tree) -> bool:
                                                  (a.where, b.where)))
 
 
+def _kept() -> int:
+    return bvh.tree_room(0)[0].kept
+
+
 @settings(max_examples=40, derandomize=True)
 @given(st.integers(0, 2000), st.integers(0, 2**32 - 1), st.sampled_from(["moved", "float ulp", "unbounded",
                                                                           "swapped", "fewer", "more"]))
-def test_a_kept_tree_is_copied_only_for_the_same_shapes(n, seed, change):
-    """bvh_build copies the tree a memo keeps when the centres (as floats), slots and
-    unbounded shapes are the last build's, and builds every other: each tree is the one
-    built without a memo."""
+def test_a_kept_tree_is_found_only_for_the_same_shapes(n, seed, change):
+    """bvh_build in this thread's tree room builds nothing when the centres (as floats),
+    slots and unbounded shapes are the last build's, and builds every other: each tree is
+    the one built afresh."""
     rng = np.random.default_rng(seed)
     centers = rng.normal(size=(n, 3)) * (rng.random((n, 1)) < 0.5)  # ties among the centres
     bounded = rng.random(n) < 0.9
-    kept = bvh.memo(n + 1)
-    kept.valid = 0
-    first = bvh.build(table(centers), bounded, kept)
+    bvh.forget()
+    first = bvh.build(table(centers), bounded, kept=True)
     assert _same_tree(first, bvh.build(table(centers), bounded))
-    copies = kept.copies
-    again = bvh.build(table(centers), bounded, kept)
-    assert _same_tree(again, first) and kept.copies == copies + (len(first.items) > 0)  # none kept: no tree
+    kept = _kept()
+    again = bvh.build(table(centers), bounded, kept=True)
+    assert _same_tree(again, first) and _kept() == kept + (len(first.items) > 0)  # no tree: none kept
     other, ok = centers.copy(), bounded.copy()
     i = int(rng.integers(0, n)) if n else 0
     if change == "fewer":
@@ -372,10 +375,25 @@ def test_a_kept_tree_is_copied_only_for_the_same_shapes(n, seed, change):
         ok[[i, j]] = ok[[j, i]]
     same = len(ok) == n and np.array_equal(ok, bounded) and \
         other[ok].astype(np.float32).tobytes() == centers[ok].astype(np.float32).tobytes()  # -0 is not 0 here
-    copies = kept.copies
-    built = bvh.build(table(other), ok, kept)
+    kept = _kept()
+    built = bvh.build(table(other), ok, kept=True)
     assert _same_tree(built, bvh.build(table(other), ok))
-    assert kept.copies == copies + (same and len(first.items) > 0)
+    assert _kept() == kept + (same and len(first.items) > 0)
+
+
+def test_a_tree_room_in_use_is_not_reused():
+    """While an array made from the thread's tree room lives, the next build gets new
+    arrays (and builds): a frame's tree never changes under whoever still holds it."""
+    centers = np.random.default_rng(1).normal(size=(100, 3))
+    bvh.build(table(centers), np.ones(100, bool), kept=True)
+    held = bvh.tree_room(100)[2][:10]
+    kept = _kept()
+    assert not np.shares_memory(held, bvh.tree_room(100)[2])
+    bvh.build(table(centers), np.ones(100, bool), kept=True)
+    assert _kept() == 0  # a new memo: nothing found in it
+    del held
+    bvh.build(table(centers), np.ones(100, bool), kept=True)
+    assert _kept() == 1
 
 
 @pytest.mark.parametrize("jobs", [1, 2])
@@ -404,9 +422,10 @@ def test_frames_of_moving_shapes_match_frames_built_afresh(jobs):
     swapped[3], swapped[12] = 12, 3  # two shapes change places: the same centres, other slots
     options = EmuOptions(precision="fp32", width=64, height=48, jobs=jobs)
     scenes = [scene(order) for order in (same, same, swapped, same, swapped, swapped, same[::-1])]
-    copies = bvh.memo(0).copies
+    bvh.forget()
+    kept = _kept()
     runs = [run_program(words, options) for words in scenes]
-    assert bvh.memo(0).copies == copies + 2
+    assert _kept() == kept + 2
     for words, run in zip(scenes, runs):
         bvh.forget()
         fresh = run_program(words, options)

@@ -152,45 +152,17 @@ static inline void put(int32_t *at, int32_t v, int32_t keep)
         *at = v;
 }
 
-/* to[0..n) = from[0..n), with keep written only where it differs. */
-static void put_all(int32_t *to, const int32_t *from, int64_t n, int32_t keep)
+/* Whether memo describes the tree of these inputs, written into these arrays: rows rows,
+ * the n bounded shapes as given (a) and the outside ones (the last build's too where
+ * same_always). */
+static int memo_holds(const TreeMemo *memo, int64_t rows, const BuildItem *a, int64_t n, int64_t outside,
+                      int same_always, const int32_t *items, const int32_t *always, const int32_t *where,
+                      const int32_t *node)
 {
-    if (!keep) {
-        memcpy(to, from, (size_t)n * sizeof *to);
-        return;
-    }
-    for (int64_t i = 0; i < n; i++)
-        put(to + i, from[i], keep);
-}
-
-/* Whether memo holds the tree of these inputs: rows rows, the n bounded shapes as given
- * (a) and the outside ones (always). */
-static int memo_holds(const TreeMemo *memo, int64_t rows, const BuildItem *a, int64_t n, const int32_t *always,
-                      int64_t outside)
-{
-    return memo != NULL && memo->valid && memo->rows == rows && memo->counts[0] == n && memo->counts[1] == outside &&
-           memcmp(memo->given, a, (size_t)n * sizeof *a) == 0 &&
-           memcmp(memo->always, always, (size_t)outside * sizeof *always) == 0;
-}
-
-/* Keeps a build's inputs and outputs in memo when they fit (else memo holds none). */
-static void memo_keep(TreeMemo *memo, int64_t rows, const BuildItem *a, int64_t n, const int32_t *always,
-                      int64_t outside, const int32_t *items, const int32_t *where, const int32_t *node, int64_t nodes)
-{
-    if (memo == NULL)
-        return;
-    memo->valid = rows <= memo->capacity;
-    if (!memo->valid)
-        return;
-    memcpy(memo->given, a, (size_t)n * sizeof *a);
-    memcpy(memo->always, always, (size_t)outside * sizeof *always);
-    memcpy(memo->items, items, (size_t)n * sizeof *items);
-    memcpy(memo->where, where, (size_t)rows * sizeof *where);
-    memcpy(memo->node, node, (size_t)nodes * 2 * sizeof *node);
-    memo->rows = rows;
-    memo->counts[0] = n;
-    memo->counts[1] = outside;
-    memo->nodes = nodes;
+    return memo != NULL && memo->valid && same_always && memo->rows == rows && memo->counts[0] == n &&
+           memo->counts[1] == outside && memo->items == items && memo->always == always && memo->where == where &&
+           memo->node == node &&
+           memcmp((const BuildItem *)memo->given + memo->capacity * memo->last, a, (size_t)n * sizeof *a) == 0;
 }
 
 /* The hierarchy over the shapes of bnd (n rows) that are bounded with a finite centre;
@@ -208,9 +180,10 @@ static void memo_keep(TreeMemo *memo, int64_t rows, const BuildItem *a, int64_t 
  * With keep (other threads read the tree), items, always, where and node are written
  * only where they differ: the tree depends on the centres alone, and a frame whose shapes
  * did not move then leaves the last frame's in the other threads' caches
- * (docs/performance-history.md, "Rows left alone"). memo (NULL: none) keeps the last
- * tree: when it holds these inputs' tree, that is copied rather than built again. Returns
- * the node count. */
+ * (docs/performance-history.md, "Rows left alone"). memo (NULL: none; ignored past its
+ * capacity) holds the shapes as given, and says whether items, always, where and node
+ * hold the tree of the same shapes already, written by the last build: then nothing is
+ * built. Returns the node count. */
 int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
                   int32_t *where, int32_t *node, int64_t *count_out, void *room, int32_t keep, TreeMemo *memo)
 {
@@ -219,11 +192,16 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     if (rows <= 0)
         return 0;
     uint64_t *keys = room;  /* 2 rows keys, then the shapes twice: as given, then in Morton order */
-    BuildItem *a = (BuildItem *)(keys + 2 * rows);
+    if (memo != NULL && rows > memo->capacity)
+        memo = NULL;
+    BuildItem *a = memo != NULL ? (BuildItem *)memo->given + memo->capacity * (1 - memo->last)
+                                : (BuildItem *)(keys + 2 * rows), *sorted = (BuildItem *)(keys + 2 * rows) + rows;
+    int same_always = 1;  /* always holds the last build's (memo_holds: if these are its arrays) */
     float lo3[3] = {INFINITY, INFINITY, INFINITY}, hi3[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int64_t s = 0; s < rows; s++) {
         const double *c = bnd + B_COLUMNS * s;
         if (!(bounded[s] && isfinite(c[0]) && isfinite(c[1]) && isfinite(c[2]))) {
+            same_always &= always[outside] == (int32_t)s;
             put(always + outside++, (int32_t)s, keep);
             continue;
         }
@@ -233,18 +211,16 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     }
     count_out[0] = n;
     count_out[1] = outside;
-    if (memo_holds(memo, rows, a, n, always, outside)) {
-        put_all(items, memo->items, n, keep);
-        put_all(where, memo->where, rows, keep);
-        put_all(node, memo->node, 2 * memo->nodes, keep);
-        memo->copies++;
+    if (memo_holds(memo, rows, a, n, outside, same_always, items, always, where, node)) {
+        memo->kept++;
         return memo->nodes;
     }
+    if (memo != NULL)
+        memo->valid = 0;
     for (int64_t k = 0; k < outside; k++)
         put(where + always[k], (int32_t)(n + k), keep);
     if (n == 0)
         return 0;
-    const BuildItem *given = a;
     double side = MAX(MAX((double)hi3[0] - lo3[0], (double)hi3[1] - lo3[1]), (double)hi3[2] - lo3[2]);
     double scale = side > 0 && side < INFINITY ? (double)(1 << MORTON_BITS) / side : 0.0;  /* else one code */
     for (int64_t i = 0; i < n; i++) {
@@ -257,11 +233,11 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
         keys[i] = code << 32 | (uint64_t)i;
     }
     uint64_t *key = radix_sort(keys, keys + n, n);
-    BuildItem *sorted = a + n;
     for (int64_t i = 0; i < n; i++) {
         sorted[i] = a[key[i] & 0xFFFFFFFFu];
         key[i] >>= 32;
     }
+    const BuildItem *given = a;
     a = sorted;
     /* pending ranges: lo, hi, the parent whose right child it is (-1: none), depth */
     stack[0] = 0; stack[1] = n; stack[2] = -1; stack[3] = 0;
@@ -308,7 +284,10 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
         put(items + i, a[i].slot, keep);
         put(where + a[i].slot, (int32_t)i, keep);
     }
-    memo_keep(memo, rows, given, n, always, outside, items, where, node, count);
+    if (memo != NULL)
+        *memo = (TreeMemo){.capacity = memo->capacity, .valid = 1, .rows = rows, .counts = {n, outside},
+                           .nodes = count, .kept = memo->kept, .last = given != (BuildItem *)memo->given,
+                           .given = memo->given, .items = items, .always = always, .where = where, .node = node};
     return count;
 }
 

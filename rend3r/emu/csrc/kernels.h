@@ -179,17 +179,20 @@ typedef int64_t (*ShapeTablesFn)(const uint16_t *values, const int64_t *index, i
                                  double *bnd, uint8_t *bounded, int32_t *index_out, const Format *format,
                                  int32_t keep);
 
-/* The last tree a thread's bvh_build made, kept from frame to frame (raytracer.py
- * _TreeMemo): the tree depends on the bounded shapes' float centres and slots and on the
- * shapes outside it alone, so a frame whose shapes did not move copies it instead of
- * building it again, as a renderer keeps a scene's hierarchy between frames. */
+/* What a thread's bvh_build keeps from frame to frame (bvh.py TreeRoom): the tree depends
+ * on the bounded shapes' float centres and slots and on the shapes outside it alone, so a
+ * frame whose shapes did not move, given the arrays the last build wrote its tree into,
+ * finds that tree there and builds nothing, as a renderer keeps a scene's hierarchy
+ * between frames. */
 typedef struct {
-    int64_t capacity;       /* rows the arrays below have room for */
-    int64_t valid;          /* 1: they hold the inputs and outputs of the last build */
+    int64_t capacity;       /* shapes the room below holds */
+    int64_t valid;          /* 1: the fields below describe the last build */
     int64_t rows, counts[2], nodes;
-    int64_t copies;         /* the builds that copied it, since it was made */
-    void *given;            /* capacity x BUILD_ITEM_BYTES: the bounded shapes as given (kernels.c BuildItem) */
-    int32_t *always, *items, *where, *node; /* capacity each, node 2 x max(1, 2 capacity) */
+    int64_t kept;           /* the builds that found their tree so, since it was made */
+    int64_t last;           /* the half of given holding the last build's shapes */
+    void *given;            /* 2 x capacity x BUILD_ITEM_BYTES: the bounded shapes as given
+                               (kernels.c BuildItem), the last build's and the next's */
+    const int32_t *items, *always, *where, *node; /* where the last build wrote its tree */
 } TreeMemo;
 
 typedef struct {            /* a frame's set-up (setup.c frame_setup) */

@@ -178,6 +178,6 @@ def build(bnd: np.ndarray, bounded: np.ndarray, kept: bool = False) -> Tree:
     counts, room = np.zeros(2, np.int64), empty(n * native.BUILD_BYTES // 8, np.uint64)
     nodes = native.library().bvh_build(address(bnd), address(ok), n, address(items), address(always), address(where),
                                        address(node), address(counts), address(room), 0,
-                                       None if memo is None else byref(memo))
+                                       None if memo is None else byref(memo), native.shape_isa())
     tree = Tree(node[:nodes], items[:counts[0]], always[:counts[1]], where[:n])
     return Tree(*(a.copy() for a in (tree.node, tree.items, tree.always, tree.where))) if kept else tree

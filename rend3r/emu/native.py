@@ -123,8 +123,8 @@ class Setup(Structure):
                 ("sf", c_void_p), ("sf_row", c_int64), ("si", c_void_p), ("bnd", c_void_p), ("bounded", c_void_p),
                 ("index_out", c_void_p), ("items", c_void_p), ("always", c_void_p), ("node", c_void_p),
                 ("where", c_void_p),
-                ("room", c_void_p), ("memo", c_void_p), ("counts", c_int64 * 2), ("nodes", c_int64), ("shapes", c_int64), ("jobs", c_int32),
-                ("chunk", c_int64)]
+                ("room", c_void_p), ("memo", c_void_p), ("counts", c_int64 * 2), ("nodes", c_int64),
+                ("shapes", c_int64), ("jobs", c_int32), ("isa", c_int32), ("chunk", c_int64)]
 
 
 PASS_NONE, PASS_PRIMARY, PASS_SHADOW = 0, 1, 2  # a Bundle's shape pass (csrc/kernels.h)
@@ -213,7 +213,7 @@ _SUFFIXED = {  # name: (restype, argtypes); each exists once per suffix and inst
 }
 _PLAIN = {
     "bvh_build": (c_int64, [c_void_p, c_void_p, c_int64, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p, c_void_p,
-                            c_int32, c_void_p]),
+                            c_int32, c_void_p, c_int32]),
     "have_avx2": (c_int32, []),
     "have_avx512": (c_int32, []),
     "round16_array": (None, [c_void_p, c_void_p, c_int64, c_int32]),

@@ -240,7 +240,7 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
     room = bvh.Tree(node[:max(1, 2 * rows)], items[:rows], always[:rows], where[:rows])
     s.node, s.items, s.always, s.where = address(room.node), address(room.items), address(room.always), address(where)
     s.room, s.memo = address(build), addressof(memo)
-    s.jobs, s.chunk = jobs, bounds.SHAPE_CHUNK
+    s.jobs, s.isa, s.chunk = jobs, native.shape_isa(), bounds.SHAPE_CHUNK
     first = None
     if extent is not None:  # the primary bounds in the same call, around the camera origin
         apex = cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)  # at infinity: nothing is bounded

@@ -218,6 +218,7 @@ typedef struct {            /* a frame's set-up (setup.c frame_setup) */
     int64_t nodes;          /* out: its nodes */
     int64_t shapes;         /* out: the shapes on */
     int32_t jobs;           /* threads the passes split over */
+    int32_t isa;            /* the tree's Morton codes' copy (kernels.c bvh_build) */
     int64_t chunk;          /* rows a range takes at least */
 } Setup;
 

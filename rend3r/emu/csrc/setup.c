@@ -45,7 +45,8 @@ SHAPE_PASSES(avx512)
 #endif
 
 int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32_t *items, int32_t *always,
-                  int32_t *where, int32_t *node, int64_t *count_out, void *room, int32_t keep, TreeMemo *memo);
+                  int32_t *where, int32_t *node, int64_t *count_out, void *room, int32_t keep, TreeMemo *memo,
+                  int32_t isa);
 void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items, const double *keys,
                double *node_keys, int64_t lo, int64_t hi);
 
@@ -219,7 +220,7 @@ static void build_task(void *ctx, int64_t k)
     Setup *s = t->s;
     if (k == 0)
         s->nodes = bvh_build(s->bnd, s->bounded, s->shapes, s->items, s->always, s->where, s->node, s->counts,
-                             s->room, s->jobs > 1, s->memo);
+                             s->room, s->jobs > 1, s->memo, s->isa);
     else
         shape_task(t->primary, k - 1);
 }

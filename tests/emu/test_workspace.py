@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rend3r.emu import workspace
+from rend3r.emu import bvh, native, workspace
 from rend3r.emu.options import EmuOptions
 from rend3r.emu.run import run_program
 from rend3r.isa import FrameOp, Func, ShapeSet, Table, encode, lookup
@@ -200,8 +200,9 @@ def test_frames_whose_shapes_move_overwrite_the_rows_they_change(jobs: int, monk
     rewritten in one frame, then none): on a team of threads the bound table
     and the tree are written only where they differ (csrc/datapath.inc shape_tables,
     csrc/kernels.c bvh_build), so each frame's set-up finds the last frame's rows in
-    place. Every frame and its counts of tests equal those rendered with fresh arrays (a
-    stale bound would cull a moved sphere, or test every one)."""
+    place, and the last frame's tree where no shape moved (bvh.tree_room). Every frame and
+    its counts of tests equal those rendered with fresh arrays and no tree kept (a stale
+    bound would cull a moved sphere, or test every one)."""
     wall = walls.wall(4096, lights=1)
     words = list(wall.words[:-2])  # without nf, er
     xloc, yloc = (lookup(Table.SHAPE, name).index for name in ("xloc", "yloc"))
@@ -213,8 +214,13 @@ def test_frames_whose_shapes_move_overwrite_the_rows_they_change(jobs: int, monk
             words += encode(ShapeSet(s, xloc, yloc, float_to_bits(x), float_to_bits(y)))
     words = np.array(words + nf + er, np.uint32)
     options = EmuOptions(precision="fp32", width=96, height=64, jobs=jobs)
+    def fresh_tree(rows: int) -> tuple:  # new arrays, and a memo of no capacity: nothing kept
+        cap = max(1, rows)
+        return native.TreeMemo(), np.empty((2 * cap, 2), np.int32), *(np.empty(cap, np.int32) for _ in range(3))
+
     with monkeypatch.context() as m:  # one thread (every row written) into fresh arrays
         m.setattr(workspace, "SMALLEST", 1 << 62)  # no array takes a buffer
+        m.setattr(bvh, "tree_room", fresh_tree)  # no tree kept from the frame before
         fresh = run_program(words, replace(options, jobs=1), memory=0)
     got: list = []  # memory=0: the frames one after another, each on the whole team
     _on_a_thread_of_its_own(lambda: got.append(run_program(words, options, memory=0)))

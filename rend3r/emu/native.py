@@ -108,7 +108,7 @@ class LightPass(Structure):
 
 
 class TreeMemo(Structure):
-    """What a thread's tree builds keep (csrc/kernels.h TreeMemo, bvh.py TreeRoom)."""
+    """What a thread's tree builds keep (csrc/kernels.h TreeMemo, bvh.py tree_room)."""
 
     _fields_ = [("capacity", c_int64), ("valid", c_int64), ("rows", c_int64), ("counts", c_int64 * 2),
                 ("nodes", c_int64), ("kept", c_int64), ("last", c_int64), ("given", c_void_p), ("items", c_void_p),

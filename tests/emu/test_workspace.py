@@ -173,6 +173,7 @@ def test_repeated_frames_keep_their_memory_and_their_pixels(precision: str, monk
     options = EmuOptions(precision=precision, width=96, height=64, jobs=1)
     with monkeypatch.context() as m:
         m.setattr(workspace, "SMALLEST", 1 << 62)  # no array takes a buffer
+        m.setattr(bvh, "tree_room", _fresh_tree)  # nor is a tree kept
         fresh = run_program(words, options).frames[0]
     kept: list[int] = []
 
@@ -191,6 +192,12 @@ def test_repeated_frames_keep_their_memory_and_their_pixels(precision: str, monk
 
     _on_a_thread_of_its_own(runs)
     assert 0 < kept[0] and kept[-1] == kept[-2] == kept[-3] <= 2 * kept[0], kept
+
+
+def _fresh_tree(rows: int) -> tuple:
+    """bvh.tree_room's arrays made afresh, with a memo of no capacity: no tree kept."""
+    cap = max(1, rows)
+    return native.TreeMemo(), np.empty((2 * cap, 2), np.int32), *(np.empty(cap, np.int32) for _ in range(3))
 
 
 @pytest.mark.parametrize("jobs", [1, 2])
@@ -214,13 +221,9 @@ def test_frames_whose_shapes_move_overwrite_the_rows_they_change(jobs: int, monk
             words += encode(ShapeSet(s, xloc, yloc, float_to_bits(x), float_to_bits(y)))
     words = np.array(words + nf + er, np.uint32)
     options = EmuOptions(precision="fp32", width=96, height=64, jobs=jobs)
-    def fresh_tree(rows: int) -> tuple:  # new arrays, and a memo of no capacity: nothing kept
-        cap = max(1, rows)
-        return native.TreeMemo(), np.empty((2 * cap, 2), np.int32), *(np.empty(cap, np.int32) for _ in range(3))
-
     with monkeypatch.context() as m:  # one thread (every row written) into fresh arrays
         m.setattr(workspace, "SMALLEST", 1 << 62)  # no array takes a buffer
-        m.setattr(bvh, "tree_room", fresh_tree)  # no tree kept from the frame before
+        m.setattr(bvh, "tree_room", _fresh_tree)  # no tree kept from the frame before
         fresh = run_program(words, replace(options, jobs=1), memory=0)
     got: list = []  # memory=0: the frames one after another, each on the whole team
     _on_a_thread_of_its_own(lambda: got.append(run_program(words, options, memory=0)))

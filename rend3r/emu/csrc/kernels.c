@@ -230,8 +230,10 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     if (rows <= 0)
         return 0;
     uint64_t *keys = room;  /* 2 rows keys, then the shapes twice: as given, then in Morton order */
-    if (memo != NULL && rows > memo->capacity)
+    if (memo != NULL && rows > memo->capacity) {  /* too small: it keeps nothing */
+        memo->valid = 0;
         memo = NULL;
+    }
     BuildItem *a = memo != NULL ? (BuildItem *)memo->given + memo->capacity * (1 - memo->last)
                                 : (BuildItem *)(keys + 2 * rows), *sorted = (BuildItem *)(keys + 2 * rows) + rows;
     int same_always = 1;  /* always holds the last build's (memo_holds: if these are its arrays) */

@@ -179,7 +179,7 @@ typedef int64_t (*ShapeTablesFn)(const uint16_t *values, const int64_t *index, i
                                  double *bnd, uint8_t *bounded, int32_t *index_out, const Format *format,
                                  int32_t keep);
 
-/* What a thread's bvh_build keeps from frame to frame (bvh.py TreeRoom): the tree depends
+/* What a thread's bvh_build keeps from frame to frame (bvh.py tree_room): the tree depends
  * on the bounded shapes' float centres and slots and on the shapes outside it alone, so a
  * frame whose shapes did not move, given the arrays the last build wrote its tree into,
  * finds that tree there and builds nothing, as a renderer keeps a scene's hierarchy

@@ -157,8 +157,8 @@ def tree_room(rows: int) -> tuple[native.TreeMemo, np.ndarray, np.ndarray, np.nd
 
 
 def forget() -> None:
-    """Makes this thread's next tree build build (benchmarks time a program's first frame
-    so)."""
+    """Drops the tree this thread's room keeps: its next frame builds one, as a program's
+    first frame does (benchmarks time such frames so)."""
     _room.block.valid = 0
 
 

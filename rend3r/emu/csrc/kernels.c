@@ -229,7 +229,8 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     count_out[0] = count_out[1] = 0;
     if (rows <= 0)
         return 0;
-    uint64_t *keys = room;  /* 2 rows keys, then the shapes twice: as given, then in Morton order */
+    uint64_t *keys = room;  /* 2 rows keys, then the shapes twice: as given (with a memo, in its
+                               half instead), then in Morton order */
     if (memo != NULL && rows > memo->capacity) {  /* too small: it keeps nothing */
         memo->valid = 0;
         memo = NULL;

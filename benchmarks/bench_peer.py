@@ -8,7 +8,7 @@ Mitsuba subprocess, to one CPU; the emulator runs with jobs=1.
 Ours, per precision (fp16, fp32, fp64): median of --runs timed ``run_program`` calls after one
 warm-up: "run" is the whole call (decoding the program included, ~655k words at 65,536
 spheres), "render" the frame's render time. Each frame but a program's first finds the tree of the
-frame before it kept (the shapes did not move; rend3r/emu/bvh.py memo), as Mitsuba's
+frame before it kept (the shapes did not move; rend3r/emu/bvh.py tree_room), as Mitsuba's
 renders find its scene built; the scaling line also times frames with the tree built
 ("cold"). fp16 and fp32 frames are checked against fp64's
 with walls.fp16_faithful (they may differ at silhouettes only). Mitsuba, per variant: its
@@ -207,7 +207,7 @@ def scaling(sizes: list[int], runs: int) -> list[str]:
     frame, then timed), so that a drift of the machine's speed falls on both, and the
     ratio is the median of the rounds' ratios (the table's figures, minutes apart, moved
     by a third between a quiet and a slow spell). The timed frame finds the tree of the
-    frame before it kept (bvh.memo), as every frame of ours here does; a third frame,
+    frame before it kept (bvh.tree_room), as every frame of ours here does; a third frame,
     *cold*, is timed after the kept tree is dropped, as a program's first frame runs."""
     if 4096 not in sizes or 65536 not in sizes:
         return ["scaling 4,096 -> 65,536 spheres: not measured (needs --sizes 4096 65536)"]

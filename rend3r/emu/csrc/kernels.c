@@ -188,14 +188,13 @@ static inline void put(int32_t *at, int32_t v, int32_t keep)
         *at = v;
 }
 
-/* Whether memo describes the tree of these inputs, written into these arrays: rows rows,
- * the n bounded shapes as given (a) and the outside ones (the last build's too where
- * same_always). */
+/* Whether memo describes the tree of these inputs, written into these arrays: rows rows
+ * and the n bounded shapes as given (a; their slots, in order, make the outside ones the
+ * other rows, so those need no comparison of their own). */
 static int memo_holds(const TreeMemo *memo, int64_t rows, const BuildItem *a, int64_t n, int64_t outside,
-                      int same_always, const int32_t *items, const int32_t *always, const int32_t *where,
-                      const int32_t *node)
+                      const int32_t *items, const int32_t *always, const int32_t *where, const int32_t *node)
 {
-    return memo != NULL && memo->valid && same_always && memo->rows == rows && memo->counts[0] == n &&
+    return memo != NULL && memo->valid && memo->rows == rows && memo->counts[0] == n &&
            memo->counts[1] == outside && memo->items == items && memo->always == always && memo->where == where &&
            memo->node == node &&
            memcmp((const BuildItem *)memo->given + memo->capacity * memo->last, a, (size_t)n * sizeof *a) == 0;
@@ -237,12 +236,10 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     }
     BuildItem *a = memo != NULL ? (BuildItem *)memo->given + memo->capacity * (1 - memo->last)
                                 : (BuildItem *)(keys + 2 * rows), *sorted = (BuildItem *)(keys + 2 * rows) + rows;
-    int same_always = 1;  /* always holds the last build's (memo_holds: if these are its arrays) */
     float lo3[3] = {INFINITY, INFINITY, INFINITY}, hi3[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int64_t s = 0; s < rows; s++) {
         const double *c = bnd + B_COLUMNS * s;
         if (!(bounded[s] && isfinite(c[0]) && isfinite(c[1]) && isfinite(c[2]))) {
-            same_always &= always[outside] == (int32_t)s;
             put(always + outside++, (int32_t)s, keep);
             continue;
         }
@@ -252,7 +249,7 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     }
     count_out[0] = n;
     count_out[1] = outside;
-    if (memo_holds(memo, rows, a, n, outside, same_always, items, always, where, node)) {
+    if (memo_holds(memo, rows, a, n, outside, items, always, where, node)) {
         memo->kept++;
         return memo->nodes;
     }

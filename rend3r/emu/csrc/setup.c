@@ -48,7 +48,7 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
                   int32_t *where, int32_t *node, int64_t *count_out, void *room, int32_t keep, TreeMemo *memo,
                   int32_t isa);
 void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items, const double *keys,
-               double *node_keys, int64_t lo, int64_t hi);
+               double *node_keys, int64_t lo, int64_t hi, int32_t isa);
 
 /* The primary rays' shape pass over shapes a..e. */
 static void shape_range(const Bundle *b, int64_t a, int64_t e)
@@ -99,7 +99,7 @@ typedef struct {
 static void refit_range(const Bundle *b, int64_t lo, int64_t hi)
 {
     const double *keys = b->kind == BVH_FLAT ? b->keys : b->point;
-    bvh_refit(&b->tree, b->floor, b->kind, b->box, b->own, keys, b->node_keys, lo, hi);
+    bvh_refit(&b->tree, b->floor, b->kind, b->box, b->own, keys, b->node_keys, lo, hi, b->isa);
 }
 
 /* Subtree k's rows of a light's bounds (kernels.h PASS_SHADOW), its items, then its refit,

@@ -604,7 +604,9 @@ void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, con
 #pragma GCC push_options
 #pragma GCC target("avx2,avx512f,avx512vl,avx512bw,avx512dq")
 #define SB(name) name##_avx512
+#define SB_DIRECTED
 #include "shape_bounds.inc"
+#undef SB_DIRECTED
 #undef SB
 #pragma GCC pop_options
 #endif

@@ -378,16 +378,18 @@ def _kept() -> int:
     return bvh.tree_room(0)[0].kept
 
 
-@settings(max_examples=40, derandomize=True)
+@settings(max_examples=60, derandomize=True)
 @given(st.integers(0, 2000), st.integers(0, 2**32 - 1), st.sampled_from(["moved", "float ulp", "unbounded",
-                                                                          "swapped", "fewer", "more"]))
-def test_a_kept_tree_is_found_only_for_the_same_shapes(n, seed, change):
+                                                                          "swapped", "fewer", "more"]),
+       st.sampled_from([0.9, 1.0]))
+def test_a_kept_tree_is_found_only_for_the_same_shapes(n, seed, change, share):
     """bvh_build in this thread's tree room builds nothing when the centres (as floats),
     slots and unbounded shapes are the last build's, and builds every other: each tree is
-    the one built afresh."""
+    the one built afresh. A share of the shapes bounded (all of them: every block of eight
+    takes the AVX-512 first pass's vector path, which compares as it goes)."""
     rng = np.random.default_rng(seed)
     centers = rng.normal(size=(n, 3)) * (rng.random((n, 1)) < 0.5)  # ties among the centres
-    bounded = rng.random(n) < 0.9
+    bounded = rng.random(n) < share
     bvh.forget()
     first = bvh.build(table(centers), bounded, kept=True)
     assert _same_tree(first, bvh.build(table(centers), bounded))

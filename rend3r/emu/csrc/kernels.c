@@ -25,6 +25,10 @@
 #include "cull.h"
 #include "team.h"
 
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#endif
+
 /* Whether this processor runs the AVX2 build of the kernels (the _avx2 files of instances/,
  * which also use F16C's float16 conversions). */
 int32_t have_avx2(void)
@@ -188,16 +192,145 @@ static inline void put(int32_t *at, int32_t v, int32_t keep)
         *at = v;
 }
 
+/* bvh_build's first pass: what it reads and writes (keep: as bvh_build's). With last
+ * (the memo's shapes of the last build, last_n of them; NULL: none) the AVX-512 pass
+ * holds back the items while they equal last's: held counts them (then equal to the
+ * items so far), -1 once they are written. */
+typedef struct {
+    const double *bnd;
+    const uint8_t *bounded;
+    BuildItem *a;     /* the bounded shapes with a finite centre, as given */
+    int32_t *always;  /* the other shapes' slots */
+    int32_t keep;
+    const BuildItem *last;
+    int64_t last_n, held;
+} ShapesGiven;
+
+/* Writes the items held back (equal to last's) to a; from here on every item is written. */
+static inline void release(ShapesGiven *g)
+{
+    if (g->held > 0)
+        memcpy(g->a, g->last, (size_t)g->held * sizeof *g->a);
+    g->held = -1;
+}
+
+/* Shape s into a (*n of them so far) or always (*outside), its centre joined to the box
+ * lo3..hi3. */
+static inline void give_shape(ShapesGiven *g, int64_t s, int64_t *n, int64_t *outside, float *lo3, float *hi3)
+{
+    release(g);
+    const double *c = g->bnd + B_COLUMNS * s;
+    if (!(g->bounded[s] && isfinite(c[0]) && isfinite(c[1]) && isfinite(c[2]))) {
+        put(g->always + (*outside)++, (int32_t)s, g->keep);
+        return;
+    }
+    BuildItem *t = g->a + (*n)++;
+    *t = (BuildItem){{(float)c[0], (float)c[1], (float)c[2]}, (int32_t)s};
+    for (int k = 0; k < 3; k++) { lo3[k] = MIN(lo3[k], t->c[k]); hi3[k] = MAX(hi3[k], t->c[k]); }
+}
+
+/* The first pass over rows shapes, one at a time. */
+static void first_pass_base(ShapesGiven *g, int64_t rows, int64_t *n, int64_t *outside, float *lo3, float *hi3)
+{
+    for (int64_t s = 0; s < rows; s++)
+        give_shape(g, s, n, outside, lo3, hi3);
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+/* The first pass on AVX-512, eight shapes at a time where all eight are bounded with
+ * finite centres (else one at a time): their centre columns gathered, converted to floats
+ * in one instruction each, made into eight items by shuffles and joined to a box of eight
+ * lanes. The same items and outside list as first_pass_base; the box the same but for
+ * the sign of a zero at its edge, which the Morton codes do not see (x - +0 and x - -0
+ * differ only for x = -0, and then both quantise to 0). While the items equal the last
+ * build's they are compared as they are made and not written: a frame whose shapes did
+ * not move writes none and compares none after (memo_holds' memcmp of both copies). A
+ * 65,536-sphere fp32 frame whose tree is kept: 0.985x the time of the scalar pass, which
+ * wrote every item, then compared 2 MiB (interleaved A/B, 40 rounds). */
+__attribute__((target("avx2,avx512f,avx512vl,avx512dq"))) static void
+first_pass_avx512(ShapesGiven *g, int64_t rows, int64_t *n, int64_t *outside, float *lo3, float *hi3)
+{
+    const __m512i at = _mm512_setr_epi64(0, 5, 10, 15, 20, 25, 30, 35);
+    _Static_assert(B_COLUMNS == 5 && B_CENTER == 0, "at follows the bound table's rows");
+    f32x8 lo[3], hi[3];
+    for (int k = 0; k < 3; k++) {
+        lo[k] = (f32x8){0} + lo3[k];
+        hi[k] = (f32x8){0} + hi3[k];
+    }
+    const i32x8 step = {0, 1, 2, 3, 4, 5, 6, 7};
+    int64_t s = 0;
+    for (; s + 8 <= rows; s += 8) {
+        const double *c = g->bnd + B_COLUMNS * s;
+        __m512d x = _mm512_i64gather_pd(at, c, 8), y = _mm512_i64gather_pd(at, c + 1, 8),
+                z = _mm512_i64gather_pd(at, c + 2, 8);
+        uint64_t flags;
+        memcpy(&flags, g->bounded + s, sizeof flags);
+        __mmask8 ok = _mm512_test_epi64_mask(_mm512_cvtepu8_epi64(_mm_cvtsi64_si128((long long)flags)),
+                                             _mm512_set1_epi64(0xFF));
+        ok &= ~(_mm512_fpclass_pd_mask(x, 0x99) | _mm512_fpclass_pd_mask(y, 0x99) | _mm512_fpclass_pd_mask(z, 0x99));
+        if (ok != 0xFF) {  /* NaN, an infinity or a shape not bounded among them */
+            for (int64_t k = s; k < s + 8; k++)
+                give_shape(g, k, n, outside, lo3, hi3);
+            continue;
+        }
+        f32x8 f[3] = {(f32x8)_mm512_cvtpd_ps(x), (f32x8)_mm512_cvtpd_ps(y), (f32x8)_mm512_cvtpd_ps(z)};
+        f32x8 slot = (f32x8)(step + (int32_t)s);
+        for (int k = 0; k < 3; k++) {
+            lo[k] = (f32x8)SEL_BITS((i32x8)(f[k] < lo[k]), (i32x8)f[k], (i32x8)lo[k]);
+            hi[k] = (f32x8)SEL_BITS((i32x8)(f[k] > hi[k]), (i32x8)f[k], (i32x8)hi[k]);
+        }
+        f32x8 t0 = __builtin_shufflevector(f[0], f[1], 0, 8, 1, 9, 4, 12, 5, 13);
+        f32x8 t1 = __builtin_shufflevector(f[0], f[1], 2, 10, 3, 11, 6, 14, 7, 15);
+        f32x8 t2 = __builtin_shufflevector(f[2], slot, 0, 8, 1, 9, 4, 12, 5, 13);
+        f32x8 t3 = __builtin_shufflevector(f[2], slot, 2, 10, 3, 11, 6, 14, 7, 15);
+        f32x8 r0 = __builtin_shufflevector(t0, t2, 0, 1, 8, 9, 4, 5, 12, 13);  /* items 0 and 4 */
+        f32x8 r1 = __builtin_shufflevector(t0, t2, 2, 3, 10, 11, 6, 7, 14, 15);  /* 1 and 5 */
+        f32x8 r2 = __builtin_shufflevector(t1, t3, 0, 1, 8, 9, 4, 5, 12, 13);  /* 2 and 6 */
+        f32x8 r3 = __builtin_shufflevector(t1, t3, 2, 3, 10, 11, 6, 7, 14, 15);  /* 3 and 7 */
+        f32x8 out[4] = {__builtin_shufflevector(r0, r1, 0, 1, 2, 3, 8, 9, 10, 11),
+                        __builtin_shufflevector(r2, r3, 0, 1, 2, 3, 8, 9, 10, 11),
+                        __builtin_shufflevector(r0, r1, 4, 5, 6, 7, 12, 13, 14, 15),
+                        __builtin_shufflevector(r2, r3, 4, 5, 6, 7, 12, 13, 14, 15)};
+        _Static_assert(sizeof(BuildItem) == 16, "two items a vector");
+        if (g->held >= 0 && *n + 8 <= g->last_n) {  /* the last build's items so far: these too? */
+            __m256i d = _mm256_setzero_si256();
+            for (int k = 0; k < 4; k++)
+                d |= _mm256_loadu_si256((const __m256i *)(g->last + *n) + k) ^ (__m256i)out[k];
+            if (_mm256_testz_si256(d, d)) {
+                *n += 8;
+                g->held = *n;
+                continue;
+            }
+        }
+        release(g);
+        memcpy(g->a + *n, out, sizeof out);
+        *n += 8;
+    }
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 8; i++) {
+            lo3[k] = MIN(lo3[k], lo[k][i]);
+            hi3[k] = MAX(hi3[k], hi[k][i]);
+        }
+    for (; s < rows; s++)
+        give_shape(g, s, n, outside, lo3, hi3);
+}
+#define FIRST_PASS_OF(isa) ((isa) == 2 ? first_pass_avx512 : first_pass_base)
+#else
+#define FIRST_PASS_OF(isa) first_pass_base
+#endif
+
 /* Whether memo describes the tree of these inputs, written into these arrays: rows rows
- * and the n bounded shapes as given (a; their slots, in order, make the outside ones the
- * other rows, so those need no comparison of their own). */
+ * and the n bounded shapes as given (a, or with held the memo's own, which the first pass
+ * found them equal to; their slots, in order, make the outside ones the other rows, so
+ * those need no comparison of their own). */
 static int memo_holds(const TreeMemo *memo, int64_t rows, const BuildItem *a, int64_t n, int64_t outside,
-                      const int32_t *items, const int32_t *always, const int32_t *where, const int32_t *node)
+                      const int32_t *items, const int32_t *always, const int32_t *where, const int32_t *node,
+                      int held)
 {
     return memo != NULL && memo->valid && memo->rows == rows && memo->counts[0] == n &&
            memo->counts[1] == outside && memo->items == items && memo->always == always && memo->where == where &&
            memo->node == node &&
-           memcmp((const BuildItem *)memo->given + memo->capacity * memo->last, a, (size_t)n * sizeof *a) == 0;
+           (held || memcmp((const BuildItem *)memo->given + memo->capacity * memo->last, a, (size_t)n * sizeof *a) == 0);
 }
 
 /* The hierarchy over the shapes of bnd (n rows) that are bounded with a finite centre;
@@ -237,22 +370,17 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     BuildItem *a = memo != NULL ? (BuildItem *)memo->given + memo->capacity * (1 - memo->last)
                                 : (BuildItem *)(keys + 2 * rows), *sorted = (BuildItem *)(keys + 2 * rows) + rows;
     float lo3[3] = {INFINITY, INFINITY, INFINITY}, hi3[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int64_t s = 0; s < rows; s++) {
-        const double *c = bnd + B_COLUMNS * s;
-        if (!(bounded[s] && isfinite(c[0]) && isfinite(c[1]) && isfinite(c[2]))) {
-            put(always + outside++, (int32_t)s, keep);
-            continue;
-        }
-        BuildItem *t = a + n++;
-        *t = (BuildItem){{(float)c[0], (float)c[1], (float)c[2]}, (int32_t)s};
-        for (int k = 0; k < 3; k++) { lo3[k] = MIN(lo3[k], t->c[k]); hi3[k] = MAX(hi3[k], t->c[k]); }
-    }
+    int last = memo != NULL && memo->valid;
+    ShapesGiven g = {bnd, bounded, a, always, keep, last ? (const BuildItem *)memo->given + memo->capacity * memo->last : NULL,
+                     last ? memo->counts[0] : 0, last ? 0 : -1};
+    FIRST_PASS_OF(isa)(&g, rows, &n, &outside, lo3, hi3);
     count_out[0] = n;
     count_out[1] = outside;
-    if (memo_holds(memo, rows, a, n, outside, items, always, where, node)) {
+    if (memo_holds(memo, rows, a, n, outside, items, always, where, node, g.held == n)) {
         memo->kept++;
         return memo->nodes;
     }
+    release(&g);
     if (memo != NULL)
         memo->valid = 0;
     for (int64_t k = 0; k < outside; k++)
@@ -417,7 +545,6 @@ typedef float (*Round32)(double);
 static inline float down32_base(double x) { return (float)floor32(x); }
 static inline float up32_base(double x) { return (float)ceil32(x); }
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
 __attribute__((target("avx512f"))) static inline float down32_avx512(double x)
 {
     return _mm_cvtss_f32(_mm_cvt_roundsd_ss(_mm_setzero_ps(), _mm_set_sd(x), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));

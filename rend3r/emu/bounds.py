@@ -24,6 +24,10 @@ from .workspace import arrays, empty
 #: Shapes or items a range of a set-up pass takes at least (csrc/setup.c): the passes take
 #: about 30 ns a shape, and a team of threads hands a range over in about a microsecond.
 SHAPE_CHUNK = 1 << 10
+#: A frame's primary bounds over more shapes than this leave the largest subtrees of at
+#: most this many items to be made when a packet first enters them (csrc/setup.c
+#: bundle_lazy; 0: every subtree made up front).
+LAZY_ITEMS = 256
 
 
 @dataclass

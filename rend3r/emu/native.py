@@ -42,6 +42,7 @@ BV_SINE, BV_SIN2, BV_FLOOR, BV_F32, BV_COLUMNS = 3, 5, 6, 7, 10  # their columns
 BX_COLUMNS = 6  # a shape's own box on the axes normal to parallel lines, then rounded to floats (4 floats)
 CI_COLUMNS = 5  # a shape's own cone around an apex: unit axis, sine and cosine of its half-angle
 SK_COLUMNS, PK_COLUMNS = 6, 9  # a point light's behind terms per shape and per node (csrc/kernels.h)
+LAZY_READY, LAZY_WAITING = 0, 1  # a node of a frame's primary bundle: made, or a subtree's root that waits
 
 
 class Format(Structure):
@@ -88,7 +89,7 @@ class Band(Structure):
                 ("slot", c_void_p), ("sqd", c_void_p),
                 ("pt", c_void_p), ("nm", c_void_p), ("npix", c_int64), ("bad", c_void_p), ("nan_px", c_void_p),
                 ("acc", c_void_p), ("index", c_void_p), ("background", c_int32), ("rgb", c_void_p),
-                ("depth", c_void_p), ("prov", c_void_p), ("in_pass", c_void_p)]
+                ("depth", c_void_p), ("prov", c_void_p), ("in_pass", c_void_p), ("lazy", c_void_p)]
 
 
 class Pairs(Structure):
@@ -139,7 +140,8 @@ class Bundle(Structure):
                 ("unit", c_void_p), ("u", c_double), ("tiny", c_double), ("overflow", c_double),
                 ("radius", c_void_p), ("floor", c_void_p), ("pc", c_void_p), ("pc32", c_void_p), ("behind", c_void_p),
                 ("keys", c_void_p), ("point", c_void_p), ("tree", Bvh), ("items", c_int64), ("box", c_void_p),
-                ("own", c_void_p), ("node_keys", c_void_p), ("jobs", c_int32), ("isa", c_int32), ("chunk", c_int64)]
+                ("own", c_void_p), ("node_keys", c_void_p), ("jobs", c_int32), ("isa", c_int32), ("chunk", c_int64),
+                ("lazy", c_void_p), ("lazy_items", c_int64)]
 
 
 LF_PARALLEL, LF_APEX, LF_UNIT, LF_LENGTH, LF_AXES, LF_COLUMNS = 0, 1, 4, 7, 8, 14

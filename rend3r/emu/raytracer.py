@@ -84,6 +84,7 @@ class _Frame:
     shapes: native.Shapes
     tree: bvh.Tree
     primary: _Primary | None  # a grid camera's primary bounds (None: each band measures its directions)
+    waiting: _Waiting | None  # its bundle, whose subtrees may wait to be made (None with primary)
 
     def kernel(self, name: str):
         """The compiled kernel ``name`` for this frame's precision."""
@@ -143,14 +144,14 @@ def set_up(scene: Scene, options: EmuOptions) -> _Frame:
     cam = _CAMERAS.get(camera_key(scene, options, ar), lambda: _Camera.of(camera_rays(scene, options, ar), dtype))
     fmt = None if ar.native else native.Format.of(ar)
     jobs = options.jobs or threads.available_cores()
-    sf, si, bnd, bounded, index, tree, primary = _shapes(scene, ar, fmt, cam.block, cam.extent, jobs)
+    sf, si, bnd, bounded, index, tree, primary, waiting = _shapes(scene, ar, fmt, cam.block, cam.extent, jobs)
     lit = _LIGHTS.get(lights_key(scene, ar, options.light_model),
                       lambda: _Lights.of(lights_from_scene(scene, ar, options.light_model), dtype))
     n = len(sf)
     view = native.Shapes(native.ptr(sf, dtype, (n, native.SF_COLUMNS)), native.ptr(si, np.int64, (n, native.SI_COLUMNS)),
                          native.ptr(bnd, np.float64, (n, native.B_COLUMNS)), n, ar.unit_roundoff, ar.tiny, fmt)
     return _Frame(ar, dtype, cam.block, cam.xs, cam.ys, cam.rotated, sf, si, index, bnd, bounded, lit.lights, lit.rows,
-                  lit.frames, lit.scales, jobs, view, tree, primary)
+                  lit.frames, lit.scales, jobs, view, tree, primary, waiting)
 
 
 @dataclass(frozen=True, eq=False)
@@ -217,7 +218,8 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
     """The shapes that are on, as the kernels' tables (csrc/datapath.inc shape_tables, with
     the camera origin ``cam`` in each shape's normal space): (floats, ints, bounds,
     bounded, program index) in index order, then the hierarchy over them and, given the
-    primary directions' ``extent``, the primary rays' bounds; in one call on a team of
+    primary directions' ``extent``, the primary rays' bounds and their bundle (whose
+    subtrees may wait for the bands to make them); in one call on a team of
     ``jobs`` threads (csrc/setup.c frame_setup). Spheres with moderate maps are bounded
     (culled, csrc/bounds.h) in every format: a test that overflows is a miss, and a format
     too coarse for the bounds (docs/emulator.md section 7) gets infinite cull radii from
@@ -241,18 +243,20 @@ def _shapes(scene: Scene, ar: Arith, fmt, cam: np.ndarray, extent: tuple[float, 
     s.node, s.items, s.always, s.where = address(room.node), address(room.items), address(room.always), address(where)
     s.room, s.memo = address(build), addressof(memo)
     s.jobs, s.isa, s.chunk = jobs, native.shape_isa(), bounds.SHAPE_CHUNK
-    first = None
+    first = waiting = None
     if extent is not None:  # the primary bounds in the same call, around the camera origin
         apex = cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3].astype(np.float64)  # at infinity: nothing is bounded
         first = bounds.primary(bnd, bounded, apex, *extent, ar.unit_roundoff, ar.tiny, ar.overflow)
-        fitted, own = room.bounds_for(first.block, apex, None, room.nodes, False, jobs)  # own: the call's scratch
+        fitted, own = room.bounds_for(first.block, apex, None, room.nodes, False, jobs)
+        waiting = _Waiting(first, own, empty(room.nodes, np.uint8))  # the bands may make its subtrees
+        first.block.lazy, first.block.lazy_items = address(waiting.state), bounds.LAZY_ITEMS
     with threads.team(jobs) as team:
         n = native.library().frame_setup(byref(s), None if first is None else byref(first.block), team)
     tree = bvh.Tree(room.node[:s.nodes], room.items[:s.counts[0]], room.always[:s.counts[1]], room.where[:n])
     primary = None if first is None else \
         (bvh.Bounds(tree, fitted.box[:s.nodes], fitted.frame), first.floor[:n], first.pc[:n],
          first.pc32[:n])
-    return sf[:n], si[:n], bnd[:n], bounded[:n], out[:n], tree, primary
+    return sf[:n], si[:n], bnd[:n], bounded[:n], out[:n], tree, primary, waiting
 
 
 @dataclass(frozen=True)
@@ -317,6 +321,8 @@ def _bands(fr: _Frame, options: EmuOptions, rows: int) -> tuple[native.Bands, li
         primary = (fitted, p.floor, p.pc, p.pc32)
         b.primary = pointer(p.block)
         keep += [p, own]
+    elif fr.waiting is not None:  # the frame's bundle: the bands make its waiting subtrees
+        band.lazy = addressof(fr.waiting.made.block)
     tree, floor, pc, pc32 = primary
     band.pc, band.pc32, band.floor, band.tree = address(pc), address(pc32), address(floor), tree.view
     band.index, band.background = address(fr.index), options.background
@@ -338,6 +344,18 @@ def _bands(fr: _Frame, options: EmuOptions, rows: int) -> tuple[native.Bands, li
 
 #: What render_band counts (csrc/kernels.h BC_*, in this order).
 _BAND_COUNTS = ("tests", "skipped", "nan_tests", "nan_rays", "hits", "shadow_rays")
+
+
+@dataclass(frozen=True)
+class _Waiting:
+    """A frame's primary bundle, whose subtrees may wait to be made until a packet first
+    enters them (``csrc/setup.c`` bundle_lazy, lazy_refine): what the bands then need.
+    Until a band makes a subtree, its shapes' floors and cull data and the nodes below its
+    root hold nothing."""
+
+    made: bounds.Pass  # the bundle's block and the arrays it points at
+    own: np.ndarray  # its items' cones (csrc/kernels.h CI_COLUMNS)
+    state: np.ndarray  # per node, csrc/kernels.h LAZY_*
 
 
 #: A frame's (or band's) primary bounds: the hierarchy's, and per shape its depth floor

@@ -8,7 +8,7 @@ as the reference renders them, while testing a small share of the pairs.
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import event, given, settings, strategies as st
 
 from rend3r.emu import bounds, bvh, native
 from rend3r.emu.arith import make_arith
@@ -141,3 +141,56 @@ def test_a_squared_direction_length_that_overflows_bounds_nothing(dmin):
     p = bounds.primary(bnd, ok, np.zeros(3), dmin, dmin, ar.unit_roundoff, ar.tiny, ar.overflow)
     bvh.build(bnd, ok).fit(p, apex=np.zeros(3))
     assert (p.radius == np.inf).all()
+
+
+@settings(max_examples=40, derandomize=True)
+@given(st.sampled_from(ARITHS + OTHER), st.integers(40, 400), st.floats(0.3, 3.0), st.booleans(),
+       st.tuples(coord, coord, coord), st.integers(0, 2**31))
+def test_a_waiting_subtree_bounds_every_shape_below_it(arith, n, spread, turned, cam, seed):
+    """A subtree left to be made when first entered (csrc/setup.c bundle_lazy) gets bounds
+    from its shapes' extremes (shape_bounds.inc subtree_bound): its depth floor is at most
+    each of its shapes' own, and its cone holds every line through the camera that meets
+    one of their balls (centre, cull radius), as the bundle made whole computes them."""
+    rng = np.random.default_rng(seed)
+    p = Prog().nr().cam(xloc=cam[0], yloc=cam[1], zloc=cam[2], hfov=0.3, vfov=0.3)
+    for i in range(n):
+        loc = rng.normal(size=3) * spread + (0.0, 0.0, -8.0)
+        inv = 2.0 ** rng.uniform(-1.5, 1.5, size=3)
+        rot = tuple(rng.normal(size=4)) if turned else (1.0, 0.0, 0.0, 0.0)
+        p.sphere(i, loc=tuple(loc), scale=tuple(inv), rot=rot)
+    scene = _scene(p)
+    options = EmuOptions(precision=arith[0], subnormals=arith[1], width=32, height=24)
+    kept = bounds.LAZY_ITEMS
+    try:
+        bounds.LAZY_ITEMS = 0
+        whole = set_up(scene, options)
+        bounds.LAZY_ITEMS = 12
+        part = set_up(scene, options)
+    finally:
+        bounds.LAZY_ITEMS = kept
+    tree, box = part.tree, part.primary[0].box
+    floor, radius, bnd = whole.primary[1], whole.waiting.made.radius, whole.bnd
+    apex = np.array([float(c) for c in whole.cam[native.CAM_ORIGIN:native.CAM_ORIGIN + 3]], np.longdouble)
+    waiting = np.flatnonzero(np.asarray(part.waiting.state[:tree.nodes]) == native.LAZY_WAITING)
+    assert len(waiting) > 0 and len(tree.items) > 12
+    for at in waiting:
+        right = at
+        while tree.node[right, 1] == 0:
+            right = tree.node[right, 0]
+        left = at
+        while tree.node[left, 1] == 0:
+            left += 1
+        slots = tree.items[tree.node[left, 0]:tree.node[right, 0] + tree.node[right, 1]]
+        b = box[at]
+        assert b[native.BV_FLOOR] <= floor[slots].min()
+        event(f"a floor: {'yes' if b[native.BV_FLOOR] > 0 else 'no'}; a cone: {'yes' if b[native.BV_SINE] < np.inf else 'no'}")
+        if not b[native.BV_SINE] < np.inf:
+            continue
+        axis = b[:3].astype(np.longdouble)  # BV_AXIS
+        half = np.arcsin(np.longdouble(b[native.BV_SINE]))
+        for s in slots:
+            v = bnd[s, :3].astype(np.longdouble) - apex
+            dist = np.sqrt(v @ v)
+            assert radius[s] < dist  # else the subtree could hold no cone
+            turn = np.arccos(np.clip(abs(v @ axis) / dist / np.sqrt(axis @ axis), -1, 1))
+            assert turn + np.arcsin(np.longdouble(radius[s]) / dist) <= half

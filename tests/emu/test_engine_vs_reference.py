@@ -171,21 +171,23 @@ def check(words: list[int], options: EmuOptions) -> None:
 
 
 def compare(scene: Scene, options: EmuOptions) -> FrameStats:
-    """The engine's frame against the oracle's, then split over threads and bands; returns
-    the engine's stats."""
+    """The engine's frame against the oracle's, then split over threads and bands with the
+    primary hierarchy's subtrees of a few items made when first entered; returns the
+    engine's stats."""
     engine, stats = render_frame(scene, options)
     assert_same(engine, render_reference(scene, options))
-    chunks = raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK, raytracer.BAND_PIXELS
+    chunks = raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK, raytracer.BAND_PIXELS, bounds.LAZY_ITEMS
     # tiny chunks: every pass split over the team; bands of 5 rows (the last one shorter)
     raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK, raytracer.BAND_PIXELS = 16, 2, 5 * options.width
     try:
-        for jobs in (1, 3):  # one thread; a team of three
+        for jobs, lazy in ((1, 8), (3, 16)):  # one thread; a team of three, racing to make subtrees
+            bounds.LAZY_ITEMS = lazy
             split, counts = render_frame(scene, replace(options, jobs=jobs))
             assert_same(engine, split)
             # (tests and those meeting NaN depend on what each band's bounds skip)
             assert (counts.hits, counts.shadow_rays) == (stats.hits, stats.shadow_rays)
     finally:
-        raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK, raytracer.BAND_PIXELS = chunks
+        raytracer.MIN_CHUNK, bounds.SHAPE_CHUNK, raytracer.BAND_PIXELS, bounds.LAZY_ITEMS = chunks
     return stats
 
 

@@ -619,6 +619,30 @@ static inline void point_join(double *pk, const double *e, int shape)
     pk[PK_R] = r <= pk[PK_R] ? pk[PK_R] : r == r ? r : INFINITY;
 }
 
+/* What the kernels' tests read of a cone node b from its axis, sine and floor: the squared
+ * sine widened (inf from CONE_EVERY on: every line), and the float columns (bvh.h
+ * cone_missed8): the floor rounded down, the axis rounded, the float test's squared sine
+ * rounded up. */
+static inline __attribute__((always_inline)) void cone_tests(double *b, Round32 down, Round32 up)
+{
+    float *f = node32(b, BV_F32);
+    f[F32_FLOOR] = down(b[BV_FLOOR]);
+    double sine = b[BV_SINE];
+    int cone = sine < CONE_EVERY && b[BV_AXIS] == b[BV_AXIS];
+    b[BV_SIN2] = cone ? sine * sine * (1.0 + 1e-9) : INFINITY;
+    for (int c = 0; c < 3; c++)
+        f[F32_AXIS + c] = (float)b[BV_AXIS + c];
+    f[F32_SIN2] = cone ? up((sine * (1.0 + 1e-9) + 8 * U32) * (sine * (1.0 + 1e-9) + 8 * U32) * (1.0 + 10 * U32))
+                       : INFINITY;
+    f[F32_PAD] = 0.0f;
+}
+
+/* cone_tests for a node whose bounds are set otherwise (setup.c bundle_lazy). */
+void cone_node(double *b)
+{
+    cone_tests(b, down32_base, up32_base);
+}
+
 /* bvh_refit for lines through an apex: per node the double cone holding its shapes'
  * cones, its least floor, the cone's squared sine for the tests, and where keys is not
  * NULL (a point light's shadow rays: SK_COLUMNS per shape) its behind-test terms
@@ -660,16 +684,7 @@ static inline __attribute__((always_inline)) void refit_cones(const Bvh *t, cons
             }
         }
         b[BV_FLOOR] = fl;
-        float *f = node32(b, BV_F32);
-        f[F32_FLOOR] = down(fl);
-        double sine = b[BV_SINE];
-        int cone = sine < CONE_EVERY && b[BV_AXIS] == b[BV_AXIS];
-        b[BV_SIN2] = cone ? sine * sine * (1.0 + 1e-9) : INFINITY;
-        for (int c = 0; c < 3; c++)
-            f[F32_AXIS + c] = (float)b[BV_AXIS + c];
-        f[F32_SIN2] = cone ? up((sine * (1.0 + 1e-9) + 8 * U32) * (sine * (1.0 + 1e-9) + 8 * U32) * (1.0 + 10 * U32))
-                           : INFINITY;
-        f[F32_PAD] = 0.0f;
+        cone_tests(b, down, up);
         if (keys != NULL)
             memcpy(node_keys + PK_COLUMNS * at, pk, sizeof pk);
     }

@@ -145,6 +145,8 @@ typedef struct {            /* the primary rays of one band of rows */
     int32_t *prov;
     const struct Bands *in_pass; /* a frame of one shape with lights: its lights, which the nearest-hit pass
                                     applies (band.c render_band; else NULL) */
+    struct Bundle *lazy;    /* the frame's primary bundle, whose subtrees may wait to be refined (setup.c
+                               lazy_refine; NULL: none) */
 } Band;
 
 typedef struct {            /* one light over one band */
@@ -230,7 +232,7 @@ typedef struct {            /* a frame's set-up (setup.c frame_setup) */
  * subtree_task); the other passes' rows are by slot. */
 enum { PASS_NONE = 0, PASS_PRIMARY = 1, PASS_SHADOW = 2 };
 
-typedef struct {            /* one bundle of rays' bounds (setup.c bundle_bounds) */
+typedef struct Bundle {     /* one bundle of rays' bounds (setup.c bundle_bounds) */
     const double *bnd;      /* n x B_COLUMNS */
     const uint8_t *ok;      /* per shape: bounded */
     int64_t n;
@@ -251,7 +253,19 @@ typedef struct {            /* one bundle of rays' bounds (setup.c bundle_bounds
     double *node_keys;      /* out where keys or point is given: nodes x 3 or PK_COLUMNS */
     int32_t jobs, isa;      /* threads the passes split over; the shape passes' copy (native.py shape_isa) */
     int64_t chunk;          /* shapes or items a range takes at least */
+    uint8_t *lazy;          /* primary rays, in the frame's set-up: per node (room for 2 n), LAZY_* (NULL: the
+                               bundle is made whole, as every other) */
+    int64_t lazy_items;     /* the most items a waiting subtree holds */
 } Bundle;
+
+/* A frame's primary bundle over more than lazy_items shapes is made in part (setup.c
+ * bundle_lazy): the roots of the largest subtrees of at most lazy_items items get bounds
+ * from their shapes' extremes and wait (LAZY_WAITING); their shapes' bounds, their items'
+ * cones and the nodes below them are made when a packet first enters one (lazy_refine:
+ * LAZY_BUSY, then LAZY_READY), so that subtrees no packet enters cost only their
+ * extremes (docs/performance.md, "Subtrees made when first entered"). */
+enum { LAZY_READY = 0, LAZY_WAITING = 1, LAZY_BUSY = 2, LAZY_ABOVE = 3 };
+void lazy_refine(Bundle *b, int64_t at);
 
 /* A pixel kernel of datapath.inc (directions, nearest, light_pass, shadow_origins): its
  * block, pixels (rows for nearest) a..b, and the report row it adds to. */

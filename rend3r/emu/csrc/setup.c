@@ -8,9 +8,11 @@
  * Every pass computes each shape, item or node the same way whatever the split, so the
  * bits never depend on the thread count.
  */
+#include <math.h>
 #include <stdint.h>
 #include <string.h>
 
+#include "bvh.h"
 #include "kernels.h"
 #include "team.h"
 
@@ -26,8 +28,10 @@ static int64_t shape_parts(int64_t n, int32_t jobs, int64_t smallest)
 /* ---- per-shape passes (kernels.c, shape_bounds.inc) ---- */
 
 #define SHAPE_PASSES(isa) \
-    void primary_shapes_##isa(const double *, const uint8_t *, int64_t, const double *, double, double, double, \
-                              double, double, double *, double *, double *, float *); \
+    void primary_shapes_##isa(const int32_t *, const double *, const uint8_t *, int64_t, const double *, double, \
+                              double, double, double, double, double *, double *, double *, float *); \
+    void subtree_bound_##isa(const double *, const double *, double, double, const double *, double, double, \
+                             double, double, double, double *); \
     void shadow_shapes_##isa(const int32_t *, const double *, const uint8_t *, int64_t, const double *, double, \
                              double, double, double, double, double, double, const double *, double, double *, \
                              double *, double *, double *); \
@@ -49,13 +53,21 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
                   int32_t isa);
 void bvh_refit(const Bvh *t, const double *floor, int32_t kind, double *box, const double *items, const double *keys,
                double *node_keys, int64_t lo, int64_t hi, int32_t isa);
+void cone_node(double *b);
 
 /* The primary rays' shape pass over shapes a..e. */
 static void shape_range(const Bundle *b, int64_t a, int64_t e)
 {
-    PICK(b, primary_shapes)(b->bnd + B_COLUMNS * a, b->ok + a, e - a, b->apex, b->dmin, b->dmax, b->u, b->tiny,
+    PICK(b, primary_shapes)(NULL, b->bnd + B_COLUMNS * a, b->ok + a, e - a, b->apex, b->dmin, b->dmax, b->u, b->tiny,
                             b->overflow, b->radius + a, b->floor + a, b->pc + PC_COLUMNS * a,
                             b->pc32 + P32_COLUMNS * a);
+}
+
+/* The primary rays' shape pass over the n shapes of slots. */
+static void shape_slots(const Bundle *b, const int32_t *slots, int64_t n)
+{
+    PICK(b, primary_shapes)(slots, b->bnd, b->ok, n, b->apex, b->dmin, b->dmax, b->u, b->tiny, b->overflow, b->radius,
+                            b->floor, b->pc, b->pc32);
 }
 
 /* A light's shape pass over rows a..e of its bounds (kernels.h PASS_SHADOW): the shapes of
@@ -90,6 +102,21 @@ static void item_range(const Bundle *b, int64_t a, int64_t e)
 
 /* ---- refits: subtrees side by side, then the nodes above them ---- */
 
+/* The subtree under node at: its items a..e and its nodes at..end (nodes are depth
+ * first: its items run from its leftmost leaf's first, left children at + 1, to its
+ * rightmost leaf's last, right children node[at][0], which is its last node). */
+static void subtree_span(const int32_t *node, int64_t at, int64_t *a, int64_t *e, int64_t *end)
+{
+    int64_t left = at, right = at;
+    while (node[2 * left + 1] == 0)
+        left++;
+    while (node[2 * right + 1] == 0)
+        right = node[2 * right];
+    *a = node[2 * left];
+    *e = (int64_t)node[2 * right] + node[2 * right + 1];
+    *end = right + 1;
+}
+
 typedef struct {
     const Bundle *b;
     int64_t below[MAX_PARTS][2];  /* node ranges of disjoint subtrees, largest first */
@@ -113,13 +140,8 @@ static void refit_range(const Bundle *b, int64_t lo, int64_t hi)
 static void subtree_task(void *ctx, int64_t k)
 {
     const Subtrees *s = ctx;
-    const int32_t *node = s->b->tree.node;
-    int64_t lo = s->below[k][0], left = lo, right = lo;
-    while (node[2 * left + 1] == 0)
-        left++;
-    while (node[2 * right + 1] == 0)
-        right = node[2 * right];
-    int64_t a = node[2 * left], e = (int64_t)node[2 * right] + node[2 * right + 1];
+    int64_t lo = s->below[k][0], a, e, end;
+    subtree_span(s->b->tree.node, lo, &a, &e, &end);
     if (s->b->pass == PASS_SHADOW)
         shadow_rows(s->b, s->b->tree.items + a, a, e);
     item_range(s->b, a, e);
@@ -180,6 +202,96 @@ static void bundle_tree(Bundle *b, Team *team)
     team_phase(team, subtree_task, &s, s.count);
     for (int64_t i = n_above - 1; i >= 0; i--)  /* parents after their children */
         refit_range(b, above[i], above[i] + 1);
+}
+
+/* ---- a frame's primary bundle made in part: subtrees made when first entered ---- */
+
+/* Subtree at's shapes' primary bounds, its items' cones and its nodes below at (at keeps
+ * the bounds from its shapes' extremes, which another thread may be testing). */
+static void refine(Bundle *b, int64_t at)
+{
+    int64_t a, e, end;
+    subtree_span(b->tree.node, at, &a, &e, &end);
+    shape_slots(b, b->tree.items + a, e - a);
+    item_range(b, a, e);
+    refit_range(b, at + 1, end);
+}
+
+/* Makes waiting subtree at (kernels.h LAZY_WAITING) as bundle_tree would have, once: the
+ * thread that first claims it makes it, another that meets it meanwhile waits for it. */
+void lazy_refine(Bundle *b, int64_t at)
+{
+    uint8_t *state = b->lazy + at, waiting = LAZY_WAITING;
+    if (__atomic_compare_exchange_n(state, &waiting, LAZY_BUSY, 0, __ATOMIC_ACQUIRE, __ATOMIC_ACQUIRE)) {
+        refine(b, at);
+        __atomic_store_n(state, LAZY_READY, __ATOMIC_RELEASE);
+        return;
+    }
+    for (int64_t spins = 1; __atomic_load_n(state, __ATOMIC_ACQUIRE) != LAZY_READY; spins++)
+        team_relax(spins);
+}
+
+/* The box of the centres of items a..e's shapes, their least smallest singular value and
+ * largest largest, into the lo, hi and s (smin, smax). */
+static void extremes(const Bundle *b, int64_t a, int64_t e, double lo[3], double hi[3], double s[2])
+{
+    for (int k = 0; k < 3; k++) {
+        lo[k] = INFINITY;
+        hi[k] = -INFINITY;
+    }
+    s[0] = INFINITY;
+    s[1] = -INFINITY;
+    const int32_t *items = b->tree.items;
+    for (int64_t i = a; i < e; i++) {
+        if (i + 16 < e)
+            __builtin_prefetch(b->bnd + B_COLUMNS * (int64_t)items[i + 16]);
+        const double *r = b->bnd + B_COLUMNS * (int64_t)items[i];
+        for (int k = 0; k < 3; k++) {
+            lo[k] = MIN(lo[k], r[B_CENTER + k]);
+            hi[k] = MAX(hi[k], r[B_CENTER + k]);
+        }
+        s[0] = MIN(s[0], r[B_SMIN]);
+        s[1] = MAX(s[1], r[B_SMAX]);
+    }
+}
+
+/* The primary bundle with its largest subtrees of at most b->lazy_items items waiting
+ * (kernels.h LAZY_WAITING), each with bounds from its shapes' extremes (subtree_bound):
+ * the shapes outside the tree and the leaves above those subtrees are made now, then the
+ * nodes above, children before parents. A tree's items are all bounded with finite
+ * centres (bvh_build). */
+static void bundle_lazy(Bundle *b)
+{
+    const int32_t *node = b->tree.node;
+    int64_t stack[BVH_STACK + 2], top = 0;
+    memset(b->lazy, LAZY_READY, (size_t)b->tree.nodes);
+    shape_slots(b, b->tree.always, b->tree.nalways);
+    stack[0] = 0;
+    while (top >= 0) {
+        int64_t at = stack[top--], a, e, end;
+        subtree_span(node, at, &a, &e, &end);
+        if (node[2 * at + 1] > 0) {  /* a leaf */
+            shape_slots(b, b->tree.items + a, e - a);
+            item_range(b, a, e);
+            refit_range(b, at, at + 1);
+        } else if (e - a <= b->lazy_items) {
+            double lo[3], hi[3], ext[2], *box = b->box + BV_COLUMNS * at;
+            extremes(b, a, e, lo, hi, ext);
+            PICK(b, subtree_bound)(lo, hi, ext[0], ext[1], b->apex, b->dmin, b->dmax, b->u, b->tiny, b->overflow,
+                                   box);
+            cone_node(box);
+            b->lazy[at] = LAZY_WAITING;
+        } else {
+            b->lazy[at] = LAZY_ABOVE;
+            stack[++top] = node[2 * at];
+            stack[++top] = at + 1;
+        }
+    }
+    for (int64_t at = b->tree.nodes - 1; at >= 0; at--)
+        if (b->lazy[at] == LAZY_ABOVE) {
+            refit_range(b, at, at + 1);
+            b->lazy[at] = LAZY_READY;
+        }
 }
 
 /* One bundle of rays' bounds: its shape pass (none: radius given; a light's in its subtree
@@ -246,14 +358,21 @@ int64_t frame_setup(Setup *s, Bundle *primary, Team *team)
         n += m;
     }
     s->shapes = n;
-    if (primary != NULL)
+    if (primary != NULL) {
         primary->n = n;
-    int64_t passes = primary != NULL ? shape_parts(n, primary->jobs, primary->chunk) : 0;
+        if (!(primary->lazy_items > 0 && n > primary->lazy_items))  /* made whole */
+            primary->lazy = NULL;
+    }
+    int64_t passes = primary != NULL && primary->lazy == NULL ? shape_parts(n, primary->jobs, primary->chunk) : 0;
     team_phase(team, build_task, &t, 1 + passes);
     if (primary != NULL) {
         primary->items = s->counts[0];
         primary->tree.nodes = s->nodes;
-        bundle_tree(primary, team);
+        primary->tree.nalways = s->counts[1];
+        if (primary->lazy != NULL)
+            bundle_lazy(primary);
+        else
+            bundle_tree(primary, team);
     }
     return n;
 }

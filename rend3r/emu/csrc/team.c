@@ -43,19 +43,9 @@ void team_phase(Team *t, TeamTask fn, void *ctx, int64_t tasks)
 #include <pthread.h>
 #include <signal.h>
 
-/* Waits a little (the other threads run on other cores), then, after TEAM_SPINS calls,
- * yields the core at each: a team of more threads than cores must not spin against its
- * own leader. */
-#define TEAM_SPINS 2048
 static inline void team_wait(int64_t *spins)
 {
-    if (++*spins < TEAM_SPINS) {
-#if defined(__x86_64__) || defined(__i386__)
-        __builtin_ia32_pause();
-#endif
-    } else {
-        sched_yield();
-    }
+    team_relax(++*spins);
 }
 
 /* The CPU the calling thread runs on (-1: not known). */

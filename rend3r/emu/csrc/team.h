@@ -38,6 +38,24 @@
 
 typedef void (*TeamTask)(void *ctx, int64_t k);
 
+/* A waiting thread's spins-th wait: a little (the other threads run on other cores), then,
+ * from TEAM_SPINS on, the core yielded at each: a team of more threads than cores must not
+ * spin against its own leader. */
+#define TEAM_SPINS 2048
+static inline void team_relax(int64_t spins)
+{
+#if !TEAM_SOLO
+    if (spins >= TEAM_SPINS) {
+        sched_yield();
+        return;
+    }
+#endif
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+    (void)spins;
+}
+
 #if TEAM_SOLO
 #define TEAM_ATOMIC(t) t
 #else

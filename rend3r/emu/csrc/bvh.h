@@ -43,7 +43,7 @@ static inline i64x4 cone_missed4(const double *b, f64x4 w0, f64x4 w1, f64x4 w2, 
     return c0 * c0 + c1 * c1 + c2 * c2 > ww * b[BV_SIN2];
 }
 
-/* cone_missed4 for eight float directions w (ww: w.w in float, in [2**-100, 2**100] on
+/* cone_missed4 for a float packet's directions w (ww: w.w in float, in [2**-100, 2**100] on
  * every lane), in float: the axis rounded to floats (each component within u = 2**-24 of
  * its own), the products and sums rounded. Each computed component of w x axis is then
  * within 3u|w| of the exact one, the rounded axis adds at most u|w|, so the computed cross
@@ -53,17 +53,17 @@ static inline i64x4 cone_missed4(const double *b, f64x4 w0, f64x4 w1, f64x4 w2, 
  * |w x axis| + 7u|w| > |w| (sin + 8u): outside the cone, as the double test would find.
  * Within that range no product overflows and none underflows by more than 2**-149, far
  * below u|w|. NaN never lies outside. */
-static inline i32x8 cone_missed8(const double *b, f32x8 w0, f32x8 w1, f32x8 w2, f32x8 ww)
+static inline i32xF cone_missed_f(const double *b, f32xF w0, f32xF w1, f32xF w2, f32xF ww)
 {
     const float *f = node32c(b, BV_F32);
-    return cross2_8(f[F32_AXIS], f[F32_AXIS + 1], f[F32_AXIS + 2], w0, w1, w2) > ww * f[F32_SIN2];
+    return cross2_f(f[F32_AXIS], f[F32_AXIS + 1], f[F32_AXIS + 2], w0, w1, w2) > ww * f[F32_SIN2];
 }
 
-/* flat_missed4 for eight lanes in float: u and v rounded to floats, the box b32 (u0, u1,
+/* flat_missed4 for a float packet's lanes: u and v rounded to floats, the box b32 (u0, u1,
  * v0, v1) rounded outwards (bounds.h round32). Rounding is monotonic, so u >= u0 gives
  * fl(u) >= fl(u0) >= b32[0], and likewise at the other sides: a lane inside the box is
  * never reported outside, whatever the magnitudes (overflow included). */
-static inline i32x8 flat_missed8(const float *b32, f32x8 u, f32x8 v)
+static inline i32xF flat_missed_f(const float *b32, f32xF u, f32xF v)
 {
     return (u < b32[0]) | (u > b32[1]) | (v < b32[2]) | (v > b32[3]);
 }

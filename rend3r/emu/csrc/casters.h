@@ -82,7 +82,7 @@ static inline int may_block(const LightPass *lp, int64_t c, int64_t row, const d
 
 /* Fill e with the casters of receiver s (count -1 when s has no ball, or more than
  * CASTER_MAX casters). */
-static void casters_fill(const LightPass *lp, int64_t s, Casters *e)
+static inline void casters_fill(const LightPass *lp, int64_t s, Casters *e)
 {
     const Bvh *t = &lp->tree;
     const double *bs = lp->sh->bnd + B_COLUMNS * s;

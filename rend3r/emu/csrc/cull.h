@@ -30,10 +30,10 @@ INLINE i64x4 primary_cull4(const double *pc, f64x4 d0, f64x4 d1, f64x4 d2, f64x4
     return off | (-pc[PC_MEAN2] * vd - len * pc[PC_BEHIND] > 0.015625);
 }
 
-/* primary_cull4 for eight float directions d (ww = d.d and len = sqrt(ww), computed in
+/* primary_cull4 for a float packet's directions d (ww = d.d and len = sqrt(ww), computed in
  * float, ww in [2**-40, 2**40]) against a shape's float terms p (P32_COLUMNS) whose |v| lies in [2**-20, 2**40]
  * (kernels.c primary_shapes; else its terms are NaN and nothing is culled), in float.
- * Off the line: as bvh.h cone_missed8, with |v| for the axis's unit length, the computed
+ * Off the line: as bvh.h cone_missed_f, with |v| for the axis's unit length, the computed
  * v x d lies within 7u|v||d| of the exact one (u = 2**-24), so against the threshold
  * (sqrt(r2) + 8u|v|)^2 (1 + 10u) a lane reported off has |v x d| > |d| sqrt(r2).
  * Behind: v.d is computed within 4u|v||d|, mean2 within u, len within 2.5u of |d|; the
@@ -41,11 +41,11 @@ INLINE i64x4 primary_cull4(const double *pc, f64x4 d0, f64x4 d1, f64x4 d2, f64x4
  * 2**-6 (1 + 2**-22) leave -mean2 v.d - |d| B > 2**-6 whenever the float test holds.
  * No product overflows in these ranges, and an underflow's error (2**-149) is far below
  * the margins. NaN never culls. */
-static inline i32x8 primary_culled8(const float *p, f32x8 d0, f32x8 d1, f32x8 d2, f32x8 ww, f32x8 len)
+static inline i32xF primary_culled_f(const float *p, f32xF d0, f32xF d1, f32xF d2, f32xF ww, f32xF len)
 {
     float v0 = p[P32_V], v1 = p[P32_V + 1], v2 = p[P32_V + 2];
-    f32x8 vd = v0 * d0 + v1 * d1 + v2 * d2;
-    i32x8 off = cross2_8(v0, v1, v2, d0, d1, d2) > ww * p[P32_T];
+    f32xF vd = v0 * d0 + v1 * d1 + v2 * d2;
+    i32xF off = cross2_f(v0, v1, v2, d0, d1, d2) > ww * p[P32_T];
     return off | (-p[P32_M] * vd - len * p[P32_B] > 0x1.000004p-6f);
 }
 

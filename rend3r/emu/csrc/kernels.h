@@ -31,7 +31,7 @@ enum { PC_V = 0, PC_VV = 3, PC_R2 = 4, PC_MEAN2 = 5, PC_BEHIND = 6, PC_COLUMNS =
 /* What float lanes read of a shape instead (float, 32 bytes a shape: two to a cache line,
  * so that a pixel pass reads a quarter of the lines the double rows would take): the
  * depth floor rounded down (compared with sq_dist) and the float test's terms (cull.h
- * primary_culled8: v rounded to floats, the widened threshold of the line distance, mean2
+ * primary_culled_f: v rounded to floats, the widened threshold of the line distance, mean2
  * and the widened behind term; NaN where it must not cull). */
 enum { P32_FLOOR = 0, P32_V = 1, P32_T = 4, P32_M = 5, P32_B = 6, P32_COLUMNS = 8 };
 /* Values per shape and per light in a pixel trace. */
@@ -70,7 +70,7 @@ typedef struct {
  * lines (BVH_FLAT) the box of the balls' discs on two axes normal to them; then the least
  * depth floor below, and that
  * floor rounded down to a float; a cone also gets its axis rounded to floats and the
- * widened squared sine of the float test (bvh.h cone_missed8), a box its bounds rounded
+ * widened squared sine of the float test (bvh.h cone_missed_f), a box its bounds rounded
  * outwards to floats. */
 enum { BVH_CONE = 0, BVH_FLAT = 1 };
 /* Bytes a shape of bvh_build's working room (its Morton key twice, its centre and slot
@@ -85,7 +85,7 @@ enum { BV_AXIS = 0, BV_SINE = 3, BV_COS = 4, BV_SIN2 = 5, BV_U0 = 0, BV_U1 = 1, 
 enum { F32_FLOOR = 0, F32_AXIS = 1, F32_SIN2 = 4, F32_BOX = 1, F32_PAD = 5 };
 /* Parallel lines also get each shape's own box (BV_U0..BV_V1), per item in leaf order;
  * boxes also come rounded outwards to floats (floats from double column BX_F32 of an item:
- * u0, u1, v0, v1; bvh.h flat_missed8). */
+ * u0, u1, v0, v1; bvh.h flat_missed_f). */
 enum { BX_F32 = 4, BX_COLUMNS = 6 };
 /* A node's or an item's float columns, from double column `column` of its row on. */
 static inline float *node32(double *row, int column) { return (float *)(row + column); }

@@ -1,5 +1,6 @@
 /* SIMD packets: GCC/Clang vector extensions, 32 bytes wide (8 floats or 4 doubles; a float
- * packet's colours in double, 64 bytes).
+ * packet's colours in double, 64 bytes), or 16 floats in a unit that asks for them
+ * (FLOAT_LANES).
  *
  * Without AVX the compiler splits each operation into SSE (or NEON) operations; the
  * kernels are also built for AVX2 and chosen at load time. Lane operations are IEEE
@@ -17,6 +18,12 @@
  * of vectors, which a call would spill to memory. */
 #define INLINE static inline __attribute__((always_inline))
 
+/* A float packet's lanes: eight, or sixteen in a unit that defines FLOAT_LANES as 16
+ * before its includes (instances/f32w_avx512.c). */
+#ifndef FLOAT_LANES
+#define FLOAT_LANES 8
+#endif
+
 typedef float f32x8 __attribute__((vector_size(32)));
 typedef uint32_t u32x8 __attribute__((vector_size(32)));
 typedef int32_t i32x8 __attribute__((vector_size(32)));
@@ -30,6 +37,12 @@ typedef uint32_t u32x4 __attribute__((vector_size(16)));
 typedef float f32x4 __attribute__((vector_size(16)));
 typedef uint16_t u16x4 __attribute__((vector_size(8)));
 typedef uint16_t u16x8 __attribute__((vector_size(16)));
+typedef float f32xF __attribute__((vector_size(4 * FLOAT_LANES)));
+typedef int32_t i32xF __attribute__((vector_size(4 * FLOAT_LANES)));
+typedef uint32_t u32xF __attribute__((vector_size(4 * FLOAT_LANES)));
+typedef uint16_t u16xF __attribute__((vector_size(2 * FLOAT_LANES)));
+typedef double f64xF __attribute__((vector_size(8 * FLOAT_LANES)));
+typedef int64_t i64xF __attribute__((vector_size(8 * FLOAT_LANES)));
 
 /* Lanes 4h..4h+3 of a float packet, in double. */
 #define F32_HALF(v, h) __builtin_convertvector(                                                    \
@@ -74,11 +87,11 @@ INLINE void box_join4(f64x4 lo[3], f64x4 hi[3], i64x4 m, const f64x4 q[3])
     }
 }
 
-/* |a x w|^2 for one vector a and eight vectors w, in float (products and sums rounded in
- * this order; bvh.h cone_missed8 and cull.h primary_culled8 bound its error). */
-INLINE f32x8 cross2_8(float a0, float a1, float a2, f32x8 w0, f32x8 w1, f32x8 w2)
+/* |a x w|^2 for one vector a and a float packet's vectors w, in float (products and sums
+ * rounded in this order; bvh.h cone_missed_f and cull.h primary_culled_f bound its error). */
+INLINE f32xF cross2_f(float a0, float a1, float a2, f32xF w0, f32xF w1, f32xF w2)
 {
-    f32x8 c0 = w1 * a2 - w2 * a1, c1 = w2 * a0 - w0 * a2, c2 = w0 * a1 - w1 * a0;
+    f32xF c0 = w1 * a2 - w2 * a1, c1 = w2 * a0 - w0 * a2, c2 = w0 * a1 - w1 * a0;
     return c0 * c0 + c1 * c1 + c2 * c2;
 }
 
@@ -161,6 +174,36 @@ INLINE int mask_bits_64x4(i64x4 m)
         r |= (m[i] < 0) << i;
     return r;
 }
+#endif
+
+/* A float packet's masks as bits and back, and its flags (bytes) as bits and back. */
+#if FLOAT_LANES == 16
+INLINE int mask_bits_f(i32xF m) { return _mm512_movepi32_mask((__m512i)m); }
+INLINE i32xF bits_mask_f(int bits) { return (i32xF)_mm512_movm_epi32((__mmask16)bits); }
+INLINE int flag_bits_f(const uint8_t *a) { return flag_bits8(a) | flag_bits8(a + 8) << 8; }
+INLINE void put_flags_f(uint8_t *a, int bits)
+{
+    put_flags8(a, bits & 255);
+    put_flags8(a + 8, bits >> 8);
+}
+/* Lanes 4h..4h+3 of a float packet (a mask), in double (a four-lane double mask); four
+ * four-lane double masks as one float packet mask. */
+#define F32_PART(v, h) __builtin_convertvector(QUARTER((v), (h)), f64x4)
+#define I32_PART(m, h) __builtin_convertvector(QUARTER((m), (h)), i64x4)
+#define QUARTER(v, h) ((h) == 0 ? __builtin_shufflevector((v), (v), 0, 1, 2, 3)                      \
+                      : (h) == 1 ? __builtin_shufflevector((v), (v), 4, 5, 6, 7)                     \
+                      : (h) == 2 ? __builtin_shufflevector((v), (v), 8, 9, 10, 11)                   \
+                                 : __builtin_shufflevector((v), (v), 12, 13, 14, 15))
+#define MASK_F(c) __builtin_shufflevector(MASK_8((c)[0], (c)[1]), MASK_8((c)[2], (c)[3]), 0, 1, 2, 3, 4, 5, 6, 7, \
+                                          8, 9, 10, 11, 12, 13, 14, 15)
+#else
+INLINE int mask_bits_f(i32xF m) { return mask_bits_32x8(m); }
+INLINE i32xF bits_mask_f(int bits) { return bits_mask_32x8(bits); }
+INLINE int flag_bits_f(const uint8_t *a) { return flag_bits8(a); }
+INLINE void put_flags_f(uint8_t *a, int bits) { put_flags8(a, bits); }
+#define F32_PART(v, h) F32_HALF(v, h)
+#define I32_PART(m, h) I32_HALF(m, h)
+#define MASK_F(c) MASK_8((c)[0], (c)[1])
 #endif
 
 /* float16 rounding of 8 float lanes (fround.h round16, lane by lane): normal results by

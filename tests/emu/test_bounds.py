@@ -194,3 +194,20 @@ def test_a_waiting_subtree_bounds_every_shape_below_it(arith, n, spread, turned,
             assert radius[s] < dist  # else the subtree could hold no cone
             turn = np.arccos(np.clip(abs(v @ axis) / dist / np.sqrt(axis @ axis), -1, 1))
             assert turn + np.arcsin(np.longdouble(radius[s]) / dist) <= half
+
+
+@pytest.mark.parametrize("kinds", [(2, 3), (1, 2, 3)], ids=["none bounded", "few bounded"])
+def test_a_frame_made_in_part_with_few_or_no_bounded_shapes(kinds):
+    """More shapes than a waiting subtree holds, few or none of them spheres the tree
+    bounds (cylinders and cones stay outside it): the frame renders as the reference."""
+    p = Prog().nr().cam(hfov=0.3, vfov=0.3).dir_light(0, forward=(0.3, -0.2, -1.0))
+    for i in range(30):
+        p.sphere(i, loc=((i % 6) * 0.4 - 1.0, (i // 6) * 0.4 - 1.0, -4.0 - 0.1 * i), scale=(4.0, 4.0, 4.0),
+                 kind=kinds[i % len(kinds)], col=0x0841 * (i + 1) & 0xFFFF or 1)
+    kept = bounds.LAZY_ITEMS
+    try:
+        bounds.LAZY_ITEMS = 8
+        for precision in ("fp16", "fp32"):
+            _same(p, EmuOptions(width=40, height=30, precision=precision, jobs=2))
+    finally:
+        bounds.LAZY_ITEMS = kept

@@ -265,6 +265,10 @@ typedef struct Bundle {     /* one bundle of rays' bounds (setup.c bundle_bounds
  * LAZY_BUSY, then LAZY_READY), so that subtrees no packet enters cost only their
  * extremes (docs/performance.md, "Subtrees made when first entered"). */
 enum { LAZY_READY = 0, LAZY_WAITING = 1, LAZY_BUSY = 2, LAZY_ABOVE = 3 };
+/* A waiting subtree's extremes (shape_bounds.inc subtree_extremes): the box of its
+ * centres, its least smallest singular value and largest largest, and the least and
+ * largest |S| bounds, smin dist and smax dist. */
+enum { SX_LO = 0, SX_HI = 3, SX_SMIN = 6, SX_SMAX = 7, SX_NEAR = 8, SX_FAR = 9, SX_COLUMNS = 10 };
 void lazy_refine(Bundle *b, int64_t at);
 
 /* A pixel kernel of datapath.inc (directions, nearest, light_pass, shadow_origins): its

@@ -30,8 +30,8 @@ static int64_t shape_parts(int64_t n, int32_t jobs, int64_t smallest)
 #define SHAPE_PASSES(isa) \
     void primary_shapes_##isa(const int32_t *, const double *, const uint8_t *, int64_t, const double *, double, \
                               double, double, double, double, double *, double *, double *, float *); \
-    void subtree_bound_##isa(const double *, const double *, double, double, const double *, double, double, \
-                             double, double, double, double *); \
+    void subtree_extremes_##isa(const int32_t *, int64_t, const double *, const double *, double *); \
+    void subtree_bound_##isa(const double *, const double *, double, double, double, double, double, double *); \
     void shadow_shapes_##isa(const int32_t *, const double *, const uint8_t *, int64_t, const double *, double, \
                              double, double, double, double, double, double, const double *, double, double *, \
                              double *, double *, double *); \
@@ -231,30 +231,6 @@ void lazy_refine(Bundle *b, int64_t at)
         team_relax(spins);
 }
 
-/* The box of the centres of items a..e's shapes, their least smallest singular value and
- * largest largest, into the lo, hi and s (smin, smax). */
-static void extremes(const Bundle *b, int64_t a, int64_t e, double lo[3], double hi[3], double s[2])
-{
-    for (int k = 0; k < 3; k++) {
-        lo[k] = INFINITY;
-        hi[k] = -INFINITY;
-    }
-    s[0] = INFINITY;
-    s[1] = -INFINITY;
-    const int32_t *items = b->tree.items;
-    for (int64_t i = a; i < e; i++) {
-        if (i + 16 < e)
-            __builtin_prefetch(b->bnd + B_COLUMNS * (int64_t)items[i + 16]);
-        const double *r = b->bnd + B_COLUMNS * (int64_t)items[i];
-        for (int k = 0; k < 3; k++) {
-            lo[k] = MIN(lo[k], r[B_CENTER + k]);
-            hi[k] = MAX(hi[k], r[B_CENTER + k]);
-        }
-        s[0] = MIN(s[0], r[B_SMIN]);
-        s[1] = MAX(s[1], r[B_SMAX]);
-    }
-}
-
 /* The primary bundle with its largest subtrees of at most b->lazy_items items waiting
  * (kernels.h LAZY_WAITING), each with bounds from its shapes' extremes (subtree_bound):
  * the shapes outside the tree and the leaves above those subtrees are made now, then the
@@ -263,10 +239,11 @@ static void extremes(const Bundle *b, int64_t a, int64_t e, double lo[3], double
 static void bundle_lazy(Bundle *b)
 {
     const int32_t *node = b->tree.node;
-    int64_t stack[BVH_STACK + 2], top = 0;
+    int64_t stack[BVH_STACK + 2], top;
     memset(b->lazy, LAZY_READY, (size_t)b->tree.nodes);
     shape_slots(b, b->tree.always, b->tree.nalways);
     stack[0] = 0;
+    top = b->tree.nodes > 0 ? 0 : -1;  /* no shape bounded: every one outside the tree */
     while (top >= 0) {
         int64_t at = stack[top--], a, e, end;
         subtree_span(node, at, &a, &e, &end);
@@ -275,10 +252,9 @@ static void bundle_lazy(Bundle *b)
             item_range(b, a, e);
             refit_range(b, at, at + 1);
         } else if (e - a <= b->lazy_items) {
-            double lo[3], hi[3], ext[2], *box = b->box + BV_COLUMNS * at;
-            extremes(b, a, e, lo, hi, ext);
-            PICK(b, subtree_bound)(lo, hi, ext[0], ext[1], b->apex, b->dmin, b->dmax, b->u, b->tiny, b->overflow,
-                                   box);
+            double x[SX_COLUMNS], *box = b->box + BV_COLUMNS * at;
+            PICK(b, subtree_extremes)(b->tree.items + a, e - a, b->bnd, b->apex, x);
+            PICK(b, subtree_bound)(x, b->apex, b->dmin, b->dmax, b->u, b->tiny, b->overflow, box);
             cone_node(box);
             b->lazy[at] = LAZY_WAITING;
         } else {

@@ -263,7 +263,7 @@ typedef struct Bundle {     /* one bundle of rays' bounds (setup.c bundle_bounds
  * from their shapes' extremes and wait (LAZY_WAITING); their shapes' bounds, their items'
  * cones and the nodes below them are made when a packet first enters one (lazy_refine:
  * LAZY_BUSY, then LAZY_READY), so that subtrees no packet enters cost only their
- * extremes (docs/performance.md, "Subtrees made when first entered"). */
+ * extremes (docs/performance.md, "Decision: subtrees made when first entered"). */
 enum { LAZY_READY = 0, LAZY_WAITING = 1, LAZY_BUSY = 2, LAZY_ABOVE = 3 };
 /* A waiting subtree's extremes (shape_bounds.inc subtree_extremes): the box of its
  * centres, its least smallest singular value and largest largest, and the least and

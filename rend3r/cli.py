@@ -8,8 +8,11 @@ scapy-heavy modules they do not use.
 from __future__ import annotations
 
 import importlib
+import signal
 import sys
-from typing import NoReturn
+import threading
+from contextlib import contextmanager
+from typing import Iterator, NoReturn
 
 import click
 
@@ -17,8 +20,9 @@ from . import __version__
 from .errors import Rend3rError
 from .memory import reuse_freed_memory
 
-#: Exit status of a run stopped by Ctrl-C (128 + SIGINT, as shells report it).
-INTERRUPTED = 130
+#: Exit status of a run stopped by Ctrl-C (128 + SIGINT, as shells report it), and by
+#: SIGTERM (128 + 15).
+INTERRUPTED, TERMINATED = 130, 143
 
 #: command name -> ("module:attribute", one-line help shown by ``rend3r --help``)
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -42,6 +46,29 @@ def interrupted() -> NoReturn:
     sys.exit(INTERRUPTED)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (kill, a service manager, a CI timeout): unwinds the run as Ctrl-C does,
+    so that its staged outputs are removed and nothing is left half-written."""
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated
+
+
+@contextmanager
+def _sigterm_unwinds() -> Iterator[None]:
+    """While a command runs in the main thread, SIGTERM raises Terminated there (its
+    default would end the process at once, leaving staged files behind)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 class LazyGroup(click.Group):
     """A click group that imports a command's module only when the command is used."""
 
@@ -62,7 +89,11 @@ class LazyGroup(click.Group):
     def invoke(self, ctx: click.Context):
         reuse_freed_memory()  # the renderers' temporaries: see rend3r/memory.py
         try:
-            return super().invoke(ctx)
+            with _sigterm_unwinds():
+                return super().invoke(ctx)
+        except Terminated:  # the run's outputs were never committed
+            click.echo("\nrend3r: terminated", err=True)
+            ctx.exit(TERMINATED)
         except Rend3rError as exc:
             click.echo(str(exc) if exc.preformatted else f"rend3r: error: {exc}", err=True)
             ctx.exit(exc.exit_code)

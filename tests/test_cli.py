@@ -73,6 +73,27 @@ def test_ctrl_c_exits_130_without_a_traceback_or_output(tmp_path):
     assert not out.exists()
 
 
+def test_sigterm_mid_run_leaves_no_staged_file(tmp_path):
+    """SIGTERM while an animation's frames are staged: exit 143, one line, and neither
+    the frames nor their staged parts nor the folder the run made remain."""
+    import signal
+    import time
+
+    folder = tmp_path / "frames"
+    prog = Path(__file__).resolve().parents[1] / "programs" / "animation.asm"
+    proc = subprocess.Popen([sys.executable, "-m", "rend3r", "emulate", str(prog), "--frames", "20000",
+                             "--precision", "fp32", "-o", str(folder / "f_{n:05}.png")], stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not (folder.exists() and any(folder.iterdir())) and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)  # until the first frame is staged
+    assert proc.poll() is None, "the run ended before it was terminated"
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143, err
+    assert "Traceback" not in err and "rend3r: terminated" in err
+    assert not folder.exists()
+
+
 def test_ctrl_c_while_a_command_loads_exits_130(monkeypatch):
     """Ctrl-C during the lazy import of a command's module: exit 130 and one line, not
     click's 'Aborted!' with status 1."""

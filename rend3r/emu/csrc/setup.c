@@ -8,7 +8,6 @@
  * Every pass computes each shape, item or node the same way whatever the split, so the
  * bits never depend on the thread count.
  */
-#include <math.h>
 #include <stdint.h>
 #include <string.h>
 

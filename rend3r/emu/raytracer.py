@@ -84,7 +84,7 @@ class _Frame:
     shapes: native.Shapes
     tree: bvh.Tree
     primary: _Primary | None  # a grid camera's primary bounds (None: each band measures its directions)
-    waiting: _Waiting | None  # its bundle, whose subtrees may wait to be made (None with primary)
+    waiting: _Waiting | None  # the bundle of those bounds, whose subtrees may wait to be made (else None)
 
     def kernel(self, name: str):
         """The compiled kernel ``name`` for this frame's precision."""

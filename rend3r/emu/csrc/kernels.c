@@ -192,10 +192,11 @@ static inline void put(int32_t *at, int32_t v, int32_t keep)
         *at = v;
 }
 
-/* bvh_build's first pass: what it reads and writes (keep: as bvh_build's). With last
+/* bvh_build's first pass: what it reads and writes (keep: as bvh_build's), and what it
+ * finds: n items, outside shapes and the box lo3..hi3 of the items' centres. With last
  * (the memo's shapes of the last build, last_n of them; NULL: none) the AVX-512 pass
- * holds back the items while they equal last's: held counts them (then equal to the
- * items so far), -1 once they are written. */
+ * holds back the items while they equal last's: held counts them (then equal to n), -1
+ * once they are written. */
 typedef struct {
     const double *bnd;
     const uint8_t *bounded;
@@ -204,6 +205,8 @@ typedef struct {
     int32_t keep;
     const BuildItem *last;
     int64_t last_n, held;
+    int64_t n, outside;
+    float lo3[3], hi3[3];
 } ShapesGiven;
 
 /* Writes the items held back (equal to last's) to a; from here on every item is written. */
@@ -214,26 +217,25 @@ static inline void release(ShapesGiven *g)
     g->held = -1;
 }
 
-/* Shape s into a (*n of them so far) or always (*outside), its centre joined to the box
- * lo3..hi3. */
-static inline void give_shape(ShapesGiven *g, int64_t s, int64_t *n, int64_t *outside, float *lo3, float *hi3)
+/* Shape s into a or always, its centre joined to the box. */
+static inline void give_shape(ShapesGiven *g, int64_t s)
 {
     release(g);
     const double *c = g->bnd + B_COLUMNS * s;
     if (!(g->bounded[s] && isfinite(c[0]) && isfinite(c[1]) && isfinite(c[2]))) {
-        put(g->always + (*outside)++, (int32_t)s, g->keep);
+        put(g->always + g->outside++, (int32_t)s, g->keep);
         return;
     }
-    BuildItem *t = g->a + (*n)++;
+    BuildItem *t = g->a + g->n++;
     *t = (BuildItem){{(float)c[0], (float)c[1], (float)c[2]}, (int32_t)s};
-    for (int k = 0; k < 3; k++) { lo3[k] = MIN(lo3[k], t->c[k]); hi3[k] = MAX(hi3[k], t->c[k]); }
+    for (int k = 0; k < 3; k++) { g->lo3[k] = MIN(g->lo3[k], t->c[k]); g->hi3[k] = MAX(g->hi3[k], t->c[k]); }
 }
 
 /* The first pass over rows shapes, one at a time. */
-static void first_pass_base(ShapesGiven *g, int64_t rows, int64_t *n, int64_t *outside, float *lo3, float *hi3)
+static void first_pass_base(ShapesGiven *g, int64_t rows)
 {
     for (int64_t s = 0; s < rows; s++)
-        give_shape(g, s, n, outside, lo3, hi3);
+        give_shape(g, s);
 }
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -248,14 +250,14 @@ static void first_pass_base(ShapesGiven *g, int64_t rows, int64_t *n, int64_t *o
  * 65,536-sphere fp32 frame whose tree is kept: 0.985x the time of the scalar pass, which
  * wrote every item, then compared 2 MiB (interleaved A/B, 40 rounds). */
 __attribute__((target("avx2,avx512f,avx512vl,avx512dq"))) static void
-first_pass_avx512(ShapesGiven *g, int64_t rows, int64_t *n, int64_t *outside, float *lo3, float *hi3)
+first_pass_avx512(ShapesGiven *g, int64_t rows)
 {
     const __m512i at = _mm512_setr_epi64(0, 5, 10, 15, 20, 25, 30, 35);
     _Static_assert(B_COLUMNS == 5 && B_CENTER == 0, "at follows the bound table's rows");
     f32x8 lo[3], hi[3];
     for (int k = 0; k < 3; k++) {
-        lo[k] = (f32x8){0} + lo3[k];
-        hi[k] = (f32x8){0} + hi3[k];
+        lo[k] = (f32x8){0} + g->lo3[k];
+        hi[k] = (f32x8){0} + g->hi3[k];
     }
     const i32x8 step = {0, 1, 2, 3, 4, 5, 6, 7};
     int64_t s = 0;
@@ -270,7 +272,7 @@ first_pass_avx512(ShapesGiven *g, int64_t rows, int64_t *n, int64_t *outside, fl
         ok &= ~(_mm512_fpclass_pd_mask(x, 0x99) | _mm512_fpclass_pd_mask(y, 0x99) | _mm512_fpclass_pd_mask(z, 0x99));
         if (ok != 0xFF) {  /* NaN, an infinity or a shape not bounded among them */
             for (int64_t k = s; k < s + 8; k++)
-                give_shape(g, k, n, outside, lo3, hi3);
+                give_shape(g, k);
             continue;
         }
         f32x8 f[3] = {(f32x8)_mm512_cvtpd_ps(x), (f32x8)_mm512_cvtpd_ps(y), (f32x8)_mm512_cvtpd_ps(z)};
@@ -292,27 +294,27 @@ first_pass_avx512(ShapesGiven *g, int64_t rows, int64_t *n, int64_t *outside, fl
                         __builtin_shufflevector(r0, r1, 4, 5, 6, 7, 12, 13, 14, 15),
                         __builtin_shufflevector(r2, r3, 4, 5, 6, 7, 12, 13, 14, 15)};
         _Static_assert(sizeof(BuildItem) == 16, "two items a vector");
-        if (g->held >= 0 && *n + 8 <= g->last_n) {  /* the last build's items so far: these too? */
+        if (g->held >= 0 && g->n + 8 <= g->last_n) {  /* the last build's items so far: these too? */
             __m256i d = _mm256_setzero_si256();
             for (int k = 0; k < 4; k++)
-                d |= _mm256_loadu_si256((const __m256i *)(g->last + *n) + k) ^ (__m256i)out[k];
+                d |= _mm256_loadu_si256((const __m256i *)(g->last + g->n) + k) ^ (__m256i)out[k];
             if (_mm256_testz_si256(d, d)) {
-                *n += 8;
-                g->held = *n;
+                g->n += 8;
+                g->held = g->n;
                 continue;
             }
         }
         release(g);
-        memcpy(g->a + *n, out, sizeof out);
-        *n += 8;
+        memcpy(g->a + g->n, out, sizeof out);
+        g->n += 8;
     }
     for (int k = 0; k < 3; k++)
         for (int i = 0; i < 8; i++) {
-            lo3[k] = MIN(lo3[k], lo[k][i]);
-            hi3[k] = MAX(hi3[k], hi[k][i]);
+            g->lo3[k] = MIN(g->lo3[k], lo[k][i]);
+            g->hi3[k] = MAX(g->hi3[k], hi[k][i]);
         }
     for (; s < rows; s++)
-        give_shape(g, s, n, outside, lo3, hi3);
+        give_shape(g, s);
 }
 #define FIRST_PASS_OF(isa) ((isa) == 2 ? first_pass_avx512 : first_pass_base)
 #else
@@ -357,7 +359,7 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
                   int32_t *where, int32_t *node, int64_t *count_out, void *room, int32_t keep, TreeMemo *memo,
                   int32_t isa)
 {
-    int64_t stack[4 * BVH_STACK], top = 1, count = 0, n = 0, outside = 0;
+    int64_t stack[4 * BVH_STACK], top = 1, count = 0;
     count_out[0] = count_out[1] = 0;
     if (rows <= 0)
         return 0;
@@ -369,11 +371,14 @@ int64_t bvh_build(const double *bnd, const uint8_t *bounded, int64_t rows, int32
     }
     BuildItem *a = memo != NULL ? (BuildItem *)memo->given + memo->capacity * (1 - memo->last)
                                 : (BuildItem *)(keys + 2 * rows), *sorted = (BuildItem *)(keys + 2 * rows) + rows;
-    float lo3[3] = {INFINITY, INFINITY, INFINITY}, hi3[3] = {-INFINITY, -INFINITY, -INFINITY};
     int last = memo != NULL && memo->valid;
-    ShapesGiven g = {bnd, bounded, a, always, keep, last ? (const BuildItem *)memo->given + memo->capacity * memo->last : NULL,
-                     last ? memo->counts[0] : 0, last ? 0 : -1};
-    FIRST_PASS_OF(isa)(&g, rows, &n, &outside, lo3, hi3);
+    ShapesGiven g = {bnd, bounded, a, always, keep,
+                     last ? (const BuildItem *)memo->given + memo->capacity * memo->last : NULL,
+                     last ? memo->counts[0] : 0, last ? 0 : -1, 0, 0,
+                     {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    FIRST_PASS_OF(isa)(&g, rows);
+    int64_t n = g.n, outside = g.outside;
+    const float *lo3 = g.lo3, *hi3 = g.hi3;
     count_out[0] = n;
     count_out[1] = outside;
     if (memo_holds(memo, rows, a, n, outside, items, always, where, node, g.held == n)) {
